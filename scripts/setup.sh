@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# One-stop set-up for tdpm on Debian 12: installs the Debian packages that are
+# missing, builds build/tdpm (Release), then either renders the default scene
+# or runs every test. Idempotent: a second run installs nothing and rebuilds
+# only what changed.
+#
+#   scripts/setup.sh render   # install + build + render scenes/glass-ball.json
+#   scripts/setup.sh test     # install + build + run all tests (CTest)
+#   scripts/setup.sh build    # install + build only
+set -euo pipefail
+
+mode=${1:-render}
+case "$mode" in
+  render|test|build) ;;
+  -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
+  *) echo "setup.sh: unknown mode '$mode' (expected render, test or build)" >&2; exit 2 ;;
+esac
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+
+packages=(g++ cmake make pkg-config
+  libtbb-dev libembree-dev libxsimd-dev libopenexr-dev libpng-dev
+  doctest-dev nlohmann-json3-dev libtinyobjloader-dev libcli11-dev
+  libnanoflann-dev libbenchmark-dev openimageio-tools)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup.sh: installing ${missing[*]}"
+  sudo_cmd=()
+  if [ "$(id -u)" -ne 0 ]; then
+    command -v sudo >/dev/null || { echo "setup.sh: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+    sudo_cmd=(sudo)
+  fi
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+jobs=$(nproc 2>/dev/null || echo 2)
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j "$jobs"
+
+case "$mode" in
+  render)
+    build/tdpm render scenes/glass-ball.json -o glass-ball.exr
+    ;;
+  test)
+    cd build && ctest --output-on-failure -j "$jobs"
+    ;;
+esac

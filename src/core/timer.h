@@ -1,0 +1,19 @@
+// core/timer.h — wall-clock timing for summaries and benchmarks.
+#pragma once
+#include <chrono>
+
+namespace tdpm {
+
+class Timer {
+ public:
+  Timer() : start_(std::chrono::steady_clock::now()) {}
+  void reset() { start_ = std::chrono::steady_clock::now(); }
+  double seconds() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+
+ private:
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace tdpm

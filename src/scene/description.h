@@ -1,0 +1,127 @@
+// scene/description.h — the scene as plain, validated data.
+// scene/parse.cpp fills it from a JSON file (every value checked, errors
+// located); scene/build.cpp turns it into Embree geometry, lights, materials
+// and a camera. Nothing here knows JSON or Embree. Units: metres, seconds,
+// watts; angles in degrees as written in the file, converted where used.
+#pragma once
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "math/transform.h"
+#include "math/vec.h"
+
+namespace tdpm::scene {
+
+// Placement: world = T * R * S (scale, then rotate, then translate).
+struct TransformDesc {
+  Vec3f translate{0, 0, 0};
+  Quaternion rotate{};  // from {"axis": [x,y,z], "angle": degrees}
+  Vec3f scale{1, 1, 1};
+  Affine3f matrix() const { return Affine3f::fromTRS(translate, rotate, scale); }
+};
+
+// Keyframed motion: times strictly increasing, inside the shutter, two or
+// more. Between keyframes translation and scale are linear and rotation is
+// slerp; before the first / after the last the end pose holds. The motion is
+// applied on top of the static placement: world(t) = motion(t) * placement.
+struct MotionDesc {
+  std::vector<float> times;
+  std::vector<TransformDesc> poses;
+  bool empty() const { return times.empty(); }
+};
+
+struct TextureDesc {
+  enum class Kind { Constant, Checker };
+  Kind kind = Kind::Constant;
+  Rgb color{0.8f, 0.8f, 0.8f};   // constant colour, or checker colour A
+  Rgb color2{0.2f, 0.2f, 0.2f};  // checker colour B
+  float scale = 1.0f;            // checker cell size in object space (m)
+};
+
+struct MaterialDesc {
+  enum class Type { Diffuse, Mirror, Dielectric, Metal, Plastic };
+  Type type = Type::Diffuse;
+  std::string name;
+  TextureDesc albedo;          // diffuse: reflectance; plastic: base colour
+  Rgb specular{1, 1, 1};       // mirror/metal: reflectance; dielectric: tint
+  float ior = 1.5f;            // dielectric and plastic coating, >= 1
+  float roughness = 0.2f;      // metal, plastic: GGX alpha in (0, 1]
+};
+
+struct ShapeDesc {
+  enum class Type { Sphere, Quad, Box, Mesh };
+  Type type = Type::Sphere;
+  float radius = 1.0f;         // sphere, centred at the local origin
+  Vec3f size{1, 1, 1};         // quad: size.x by size.z in the local x-z plane,
+                               // normal +y; box: full extents, centred
+  std::string meshFile;        // mesh: path as resolved against the scene dir
+  // Mesh: triangles loaded from meshFile (object space).
+  std::vector<Vec3f> vertices;
+  std::vector<uint32_t> indices;  // 3 per triangle
+};
+
+struct ObjectDesc {
+  std::string name;
+  ShapeDesc shape;
+  uint32_t material = 0;  // index into SceneDescription::materials
+  TransformDesc placement;
+  MotionDesc motion;
+};
+
+struct LightDesc {
+  enum class Type { Point, Spot, Directional, Area };
+  Type type = Type::Point;
+  std::string name;
+  // Point, spot, area: total emitted power (W) per channel.
+  // Directional: irradiance (W/m^2) on a surface facing the light; see
+  // docs/scene-format.md for why a sun has no finite power.
+  Rgb power{100, 100, 100};
+  Vec3f position{0, 0, 0};     // point, spot
+  Vec3f direction{0, -1, 0};   // spot axis, directional travel direction (normalised)
+  float coneAngle = 30.0f;     // spot: total half-angle (degrees), (0, 90]
+  float falloffStart = 25.0f;  // spot: half-angle where falloff begins, <= coneAngle
+  Vec2f areaSize{1, 1};        // area: rectangle in the local x-z plane, emits toward local -y
+  TransformDesc placement;     // area: its placement; others: identity unless given
+  MotionDesc motion;           // any light may move
+};
+
+struct CameraKeyframe {
+  float time = 0;
+  Vec3f position{0, 0, 0};
+  Vec3f target{0, 0, -1};
+  Vec3f up{0, 1, 0};
+};
+
+struct CameraDesc {
+  Vec3f position{0, 0, 5};
+  Vec3f target{0, 0, 0};
+  Vec3f up{0, 1, 0};
+  float fovDegrees = 45.0f;       // vertical field of view, (0, 180)
+  int width = 640, height = 480;  // >= 1 each
+  float shutterOpen = 0.0f, shutterClose = 1.0f;  // close >= open
+  std::vector<CameraKeyframe> motion;  // empty: static; else >= 2, times increasing, inside the shutter
+};
+
+// Render settings stored in the scene; command-line flags override them.
+struct RenderSettings {
+  std::string method = "pathtrace";  // pathtrace | static | accumulation | standard | time
+  int spp = 16;            // samples per pixel, >= 1
+  uint64_t seed = 1;
+  int maxDepth = 16;       // path vertices, >= 1
+  float exposure = 0.0f;   // PNG preview: stops
+};
+
+struct SceneDescription {
+  std::string sourcePath;  // the JSON file, as given
+  CameraDesc camera;
+  std::vector<MaterialDesc> materials;
+  std::vector<ObjectDesc> objects;
+  std::vector<LightDesc> lights;
+  Rgb background{0, 0, 0};  // radiance of rays that escape
+  RenderSettings render;
+};
+
+}  // namespace tdpm::scene
