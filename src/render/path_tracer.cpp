@@ -1,0 +1,89 @@
+// render/path_tracer.cpp — the reference integrator.
+#include "render/path_tracer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "sampling/warp.h"
+#include "scene/bsdf.h"
+
+namespace tdpm {
+
+namespace {
+constexpr int kRouletteStartDepth = 3;
+}
+
+Rgb PathTracer::directLight(const Hit& hit, const ShadingContext& ctx, float time01, Rng& rng) const {
+  Rgb sum(0.0f);
+  for (const Light& light : scene_.lights) {
+    LightSample ls;
+    Vec2f u{rng.uniform(), rng.uniform()};
+    if (!sampleLight(light, hit.p, time01, u, ls)) continue;
+    Rgb f = bsdfEval(ctx, ls.wi);
+    if (f.isBlack()) continue;
+    float cosTheta = std::fabs(dot(ls.wi, ctx.frame.n));
+    Vec3f o = scene_.spawnOrigin(hit.p, hit.n, ls.wi);
+    // Stop short of the light's own surface (area lights are geometry).
+    float tMax = std::isinf(ls.distance) ? ls.distance : ls.distance * (1.0f - 1e-4f) - scene_.epsilon(hit.p);
+    if (tMax <= 0 || scene_.occluded(o, ls.wi, tMax, time01)) continue;
+    if (light.isDelta()) {
+      sum += f * ls.li * cosTheta;
+    } else {
+      float w = powerHeuristic(ls.pdf, bsdfPdf(ctx, ls.wi));
+      sum += f * ls.li * (cosTheta * w / ls.pdf);
+    }
+  }
+  return sum;
+}
+
+Rgb PathTracer::radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const {
+  Rgb L(0.0f), beta(1.0f);
+  bool lastDelta = true;  // the camera ray counts as "specular": no MIS on a direct hit
+  float lastPdf = 0.0f;
+  Vec3f lastP = origin;
+  for (int depth = 0; depth < maxDepth_; ++depth) {
+    Hit hit;
+    if (!scene_.intersect(origin, dir, std::numeric_limits<float>::infinity(), time01, hit)) {
+      L += beta * scene_.background;
+      break;
+    }
+    // ---- emission: a BSDF-sampled ray that hits an area light ----
+    if (hit.isLight()) {
+      const Light& light = scene_.lights[size_t(hit.light)];
+      AreaLightFrame f = areaLightFrame(light, time01);
+      Rgb le = areaLightRadiance(light, f, -dir);
+      if (!le.isBlack()) {
+        float w = lastDelta ? 1.0f : powerHeuristic(lastPdf, areaLightPdf(light, f, lastP, hit.p));
+        L += beta * le * w;
+      }
+      break;  // emitters do not reflect
+    }
+    const Material& mat = scene_.materials[scene_.objects[hit.object].material];
+    ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
+
+    // ---- next-event estimation ----
+    if (!mat.isDeltaOnly()) L += beta * directLight(hit, ctx, time01, rng);
+
+    // ---- continue the path ----
+    BsdfSample bs;
+    Vec2f u{rng.uniform(), rng.uniform()};
+    if (!bsdfSample(ctx, u, rng.uniform(), Transport::Radiance, bs)) break;
+    beta *= bs.weight;
+    if (beta.isBlack() || !isFinite(beta)) break;
+    lastDelta = bs.delta;
+    lastPdf = bs.pdf;
+    lastP = hit.p;
+    origin = scene_.spawnOrigin(hit.p, hit.n, bs.wi);
+    dir = bs.wi;
+
+    if (depth + 1 >= kRouletteStartDepth) {
+      float survive = std::min(0.95f, beta.maxComponent());
+      if (rng.uniform() >= survive) break;
+      beta = beta / survive;
+    }
+  }
+  return L;
+}
+
+}  // namespace tdpm

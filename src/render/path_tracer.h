@@ -1,0 +1,28 @@
+// render/path_tracer.h — unidirectional path tracing with next-event
+// estimation (every light sampled at every non-delta vertex), multiple
+// importance sampling against BSDF sampling for area lights (power
+// heuristic), Russian roulette, and one time per path: the unbiased
+// reference every photon-mapping method is judged against. Caustics from
+// delta lights (point, spot, sun) through specular chains cannot be found
+// by it: reference scenes for caustics use area lights.
+#pragma once
+#include "core/rng.h"
+#include "scene/scene.h"
+
+namespace tdpm {
+
+class PathTracer {
+ public:
+  PathTracer(const Scene& scene, int maxDepth) : scene_(scene), maxDepth_(maxDepth) {}
+
+  // Radiance arriving at `origin` from direction `dir`, at time time01.
+  Rgb radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const;
+
+ private:
+  Rgb directLight(const Hit& hit, const struct ShadingContext& ctx, float time01, Rng& rng) const;
+
+  const Scene& scene_;
+  int maxDepth_;
+};
+
+}  // namespace tdpm

@@ -1,0 +1,48 @@
+// scene/bsdf.h — scattering at a surface point for each Material type:
+// evaluation, density and importance sampling, in a local shading frame
+// (z = normal). One switch per call over the closed set; no virtual calls.
+//
+// Conventions: wo points away from the surface toward the viewer (or the
+// previous vertex), wi toward the next vertex / the light. `n` given to
+// makeShadingFrame is the outward geometric normal; opaque materials are
+// two-sided (the frame is flipped to wo's side), dielectrics are not.
+#pragma once
+#include "math/frame.h"
+#include "math/vec.h"
+#include "scene/material.h"
+
+namespace tdpm {
+
+// Radiance (eye paths) vs. importance (photon paths): refraction scales
+// radiance by (eta_i / eta_t)^2 but not importance (Veach 1997, ch. 5).
+enum class Transport : uint8_t { Radiance, Importance };
+
+struct ShadingContext {
+  const Material* material;
+  Rgb albedo;   // texture evaluated at the hit
+  Frame frame;  // world <-> local
+  Vec3f woLocal;
+};
+
+// Builds the context at a hit: flips the frame toward wo unless the
+// material transmits.
+ShadingContext makeShadingContext(const Material& m, Rgb albedo, Vec3f outwardNormal, Vec3f woWorld);
+
+struct BsdfSample {
+  Vec3f wi;        // world
+  Rgb weight;      // f * |cos| / pdf (delta: the reflectance / transmittance)
+  float pdf = 0;   // solid angle; 0 for delta lobes' "infinite" density
+  bool delta = false;
+};
+
+// f(wo, wi) for non-delta lobes (delta lobes contribute 0 here).
+Rgb bsdfEval(const ShadingContext& c, Vec3f wiWorld);
+float bsdfPdf(const ShadingContext& c, Vec3f wiWorld);
+// u: 2D sample; uLobe: lobe choice. Returns false if the path ends.
+bool bsdfSample(const ShadingContext& c, Vec2f u, float uLobe, Transport mode, BsdfSample& out);
+
+// Unpolarised Fresnel reflectance of a dielectric interface; cosI is the
+// cosine on the incident side, eta = eta_transmitted / eta_incident.
+float fresnelDielectric(float cosI, float eta);
+
+}  // namespace tdpm

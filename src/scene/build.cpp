@@ -1,0 +1,187 @@
+// scene/build.cpp — SceneDescription -> Scene: tessellates quads and boxes,
+// resamples motion into time steps, uploads geometry, derives light
+// constants, swept bounds and the scene's scale.
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+#include "scene/scene.h"
+
+namespace tdpm {
+
+namespace {
+
+using scene::ShapeDesc;
+
+struct TriangleMesh {
+  std::vector<Vec3f> vertices;
+  std::vector<uint32_t> indices;
+};
+
+// Quad in the local x-z plane, normal +y (counter-clockwise seen from +y).
+TriangleMesh makeQuad(float sx, float sz) {
+  float x = 0.5f * sx, z = 0.5f * sz;
+  return {{{-x, 0, -z}, {-x, 0, z}, {x, 0, z}, {x, 0, -z}}, {0, 1, 2, 0, 2, 3}};
+}
+
+// Axis-aligned box centred at the origin, outward-facing triangles.
+TriangleMesh makeBox(Vec3f size) {
+  Vec3f h = size * 0.5f;
+  TriangleMesh m;
+  for (int c = 0; c < 8; ++c) m.vertices.push_back({(c & 1) ? h.x : -h.x, (c & 2) ? h.y : -h.y, (c & 4) ? h.z : -h.z});
+  // Each face: four corners counter-clockwise seen from outside.
+  const uint32_t faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  for (const auto& f : faces) m.indices.insert(m.indices.end(), {f[0], f[1], f[2], f[0], f[2], f[3]});
+  return m;
+}
+
+std::vector<MotionKey> toKeys(const scene::MotionDesc& d) {
+  std::vector<MotionKey> keys(d.times.size());
+  for (size_t i = 0; i < keys.size(); ++i)
+    keys[i] = {d.times[i], d.poses[i].translate, d.poses[i].rotate, d.poses[i].scale};
+  return keys;
+}
+
+Motion makeMotion(const scene::TransformDesc& placement, const scene::MotionDesc& motion, const Shutter& shutter) {
+  if (motion.empty()) return Motion::still(placement.matrix());
+  return Motion::keyframed(placement.matrix(), toKeys(motion), shutter);
+}
+
+std::vector<std::vector<Vec3f>> stepVertices(const Motion& m, const std::vector<Vec3f>& local) {
+  std::vector<std::vector<Vec3f>> steps(size_t(m.stepCount()));
+  for (int s = 0; s < m.stepCount(); ++s) {
+    steps[size_t(s)].reserve(local.size());
+    for (Vec3f v : local) steps[size_t(s)].push_back(m.step(s).point(v));
+  }
+  return steps;
+}
+
+// Uniform scale factor of a step matrix (spheres require uniform scale).
+float uniformScale(const Affine3f& m) { return std::cbrt(std::fabs(m.determinant3())); }
+
+Material toMaterial(const scene::MaterialDesc& d) {
+  Material m;
+  switch (d.type) {
+    case scene::MaterialDesc::Type::Diffuse: m.type = Material::Type::Diffuse; break;
+    case scene::MaterialDesc::Type::Mirror: m.type = Material::Type::Mirror; break;
+    case scene::MaterialDesc::Type::Dielectric: m.type = Material::Type::Dielectric; break;
+    case scene::MaterialDesc::Type::Metal: m.type = Material::Type::Metal; break;
+    case scene::MaterialDesc::Type::Plastic: m.type = Material::Type::Plastic; break;
+  }
+  m.albedo.kind = d.albedo.kind == scene::TextureDesc::Kind::Checker ? Texture::Kind::Checker : Texture::Kind::Constant;
+  m.albedo.a = d.albedo.color;
+  m.albedo.b = d.albedo.color2;
+  m.albedo.invScale = 1.0f / d.albedo.scale;
+  m.specular = d.specular;
+  m.ior = d.ior;
+  // Keep GGX away from alpha -> 0, where D is a numerically unstable spike.
+  m.alpha = std::max(d.roughness, 1e-3f);
+  return m;
+}
+
+Light toLight(const scene::LightDesc& d, const Shutter& shutter) {
+  Light l;
+  switch (d.type) {
+    case scene::LightDesc::Type::Point: l.type = Light::Type::Point; break;
+    case scene::LightDesc::Type::Spot: l.type = Light::Type::Spot; break;
+    case scene::LightDesc::Type::Directional: l.type = Light::Type::Directional; break;
+    case scene::LightDesc::Type::Area: l.type = Light::Type::Area; break;
+  }
+  l.power = d.power;
+  l.position = d.position;
+  l.direction = normalize(d.direction);
+  l.cosTotal = std::cos(d.coneAngle * kPi / 180.0f);
+  l.cosFalloffStart = std::cos(d.falloffStart * kPi / 180.0f);
+  l.size = d.areaSize;
+  l.motion = makeMotion(d.placement, d.motion, shutter);
+  finalizeLight(l);
+  return l;
+}
+
+}  // namespace
+
+std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
+  auto scene = std::make_unique<Scene>();
+  Scene& s = *scene;
+  s.camera = Camera(desc.camera);
+  s.shutter = s.camera.shutter();
+  s.background = desc.background;
+  s.hasMotion = s.camera.moving();
+  for (const auto& m : desc.materials) s.materials.push_back(toMaterial(m));
+
+  for (const auto& od : desc.objects) {
+    SceneObject o;
+    o.name = od.name;
+    o.material = od.material;
+    o.motion = makeMotion(od.placement, od.motion, s.shutter);
+    if (od.shape.type == ShapeDesc::Type::Sphere) {
+      o.kind = SceneObject::Kind::Sphere;
+      float r = od.shape.radius;
+      o.objectBounds = {{-r, -r, -r}, {r, r, r}};
+      std::vector<Vec3f> centres;
+      std::vector<float> radii;
+      for (int i = 0; i < o.motion.stepCount(); ++i) {
+        centres.push_back(o.motion.step(i).point({0, 0, 0}));
+        radii.push_back(r * uniformScale(o.motion.step(i)));
+      }
+      s.geometryOwner_.push_back(int32_t(s.objects.size()));
+      uint32_t id = s.embree_.addSphere(centres, radii);
+      TDPM_ASSERT(id + 1 == s.geometryOwner_.size(), "geometry ids out of order");
+    } else {
+      TriangleMesh mesh;
+      switch (od.shape.type) {
+        case ShapeDesc::Type::Quad: mesh = makeQuad(od.shape.size.x, od.shape.size.z); break;
+        case ShapeDesc::Type::Box: mesh = makeBox(od.shape.size); break;
+        default: mesh = {od.shape.vertices, od.shape.indices}; break;
+      }
+      for (Vec3f v : mesh.vertices) o.objectBounds.extend(v);
+      o.faceNormals.reserve(mesh.indices.size() / 3);
+      for (size_t i = 0; i < mesh.indices.size(); i += 3) {
+        Vec3f a = mesh.vertices[mesh.indices[i]], b = mesh.vertices[mesh.indices[i + 1]],
+              c = mesh.vertices[mesh.indices[i + 2]];
+        Vec3f n = cross(b - a, c - a);
+        float len = length(n);
+        o.faceNormals.push_back(len > 0 ? n / len : Vec3f(0, 1, 0));
+      }
+      s.geometryOwner_.push_back(int32_t(s.objects.size()));
+      uint32_t id = s.embree_.addTriangles(stepVertices(o.motion, mesh.vertices), mesh.indices);
+      TDPM_ASSERT(id + 1 == s.geometryOwner_.size(), "geometry ids out of order");
+    }
+    o.sweptBounds = o.motion.sweptBounds(o.objectBounds);
+    s.bounds.extend(o.sweptBounds);
+    if (o.motion.moving()) {
+      s.hasMotion = true;
+      s.movingBounds.push_back(o.sweptBounds);
+    }
+    s.objects.push_back(std::move(o));
+  }
+
+  for (const auto& ld : desc.lights) {
+    Light l = toLight(ld, s.shutter);
+    if (l.motion.moving()) s.hasMotion = true;
+    if (l.type == Light::Type::Area) {
+      // The emitter is geometry too: camera and BSDF rays can hit it.
+      TriangleMesh quad = makeQuad(l.size.x, l.size.y);
+      s.geometryOwner_.push_back(-int32_t(s.lights.size()) - 1);
+      l.geometryId = s.embree_.addTriangles(stepVertices(l.motion, quad.vertices), quad.indices);
+      Bounds3f local;
+      for (Vec3f v : quad.vertices) local.extend(v);
+      Bounds3f swept = l.motion.sweptBounds(local);
+      s.bounds.extend(swept);
+      if (l.motion.moving()) s.movingBounds.push_back(swept);
+    } else if (l.type != Light::Type::Directional) {
+      for (int i = 0; i < l.motion.stepCount(); ++i) s.bounds.extend(l.motion.step(i).point(l.position));
+    }
+    s.lights.push_back(std::move(l));
+  }
+  s.embree_.commit();
+  if (!s.bounds.empty()) {
+    Vec3f d = s.bounds.diagonal();
+    s.sceneScale_ = std::max({std::fabs(s.bounds.lo.x), std::fabs(s.bounds.lo.y), std::fabs(s.bounds.lo.z),
+                              std::fabs(s.bounds.hi.x), std::fabs(s.bounds.hi.y), std::fabs(s.bounds.hi.z),
+                              length(d)});
+  }
+  return scene;
+}
+
+}  // namespace tdpm

@@ -1,0 +1,110 @@
+// scene/light.cpp — light constants and next-event sampling.
+#include "scene/light.h"
+
+#include <cmath>
+#include <limits>
+
+namespace tdpm {
+
+float Light::spotFalloff(float cosTheta) const {
+  if (cosTheta >= cosFalloffStart) return 1.0f;
+  if (cosTheta <= cosTotal) return 0.0f;
+  float d = (cosTheta - cosTotal) / (cosFalloffStart - cosTotal);
+  return (d * d) * (d * d);
+}
+
+void finalizeLight(Light& light) {
+  switch (light.type) {
+    case Light::Type::Point:
+      light.intensity = light.power / (4.0f * kPi);
+      break;
+    case Light::Type::Spot: {
+      // Power = I * integral of the falloff over the sphere
+      //       = I * 2 pi [(1 - cosFalloffStart) + (cosFalloffStart - cosTotal) / 5],
+      // the quartic blend integrating to 1/5 of its band (exact, unlike
+      // pbrt's midpoint approximation), so the stated watts are emitted.
+      float solid = 2.0f * kPi * ((1.0f - light.cosFalloffStart) + (light.cosFalloffStart - light.cosTotal) / 5.0f);
+      light.intensity = light.power / solid;
+      break;
+    }
+    case Light::Type::Directional:
+    case Light::Type::Area:
+      break;
+  }
+}
+
+AreaLightFrame areaLightFrame(const Light& light, float time01) {
+  Affine3f m = light.motion.atNormalized(time01);
+  AreaLightFrame f;
+  f.center = m.point({0, 0, 0});
+  f.edgeX = m.vector({light.size.x, 0, 0});
+  f.edgeZ = m.vector({0, 0, light.size.y});
+  Vec3f c = cross(f.edgeZ, f.edgeX);  // local (0,0,1) x (1,0,0) = +y; emitting side is -y
+  f.area = length(c);
+  f.normal = f.area > 0 ? -c / f.area : Vec3f(0, -1, 0);
+  return f;
+}
+
+Rgb areaLightRadiance(const Light& light, const AreaLightFrame& f, Vec3f dirFromLight) {
+  if (dot(f.normal, dirFromLight) <= 0 || !(f.area > 0)) return Rgb(0.0f);
+  return light.power / (kPi * f.area);  // Lambertian emitter: Phi = L * pi * A
+}
+
+float areaLightPdf(const Light& /*light*/, const AreaLightFrame& f, Vec3f p, Vec3f hit) {
+  Vec3f d = hit - p;
+  float dist2 = lengthSquared(d);
+  float cosL = std::fabs(dot(f.normal, d)) / std::sqrt(dist2);
+  if (cosL <= 0 || !(f.area > 0)) return 0.0f;
+  return dist2 / (cosL * f.area);
+}
+
+bool sampleLight(const Light& light, Vec3f p, float time01, Vec2f u, LightSample& out) {
+  switch (light.type) {
+    case Light::Type::Point:
+    case Light::Type::Spot: {
+      Affine3f m = light.motion.atNormalized(time01);
+      Vec3f lp = m.point(light.position);
+      Vec3f d = lp - p;
+      float dist2 = lengthSquared(d);
+      if (!(dist2 > 0)) return false;
+      float dist = std::sqrt(dist2);
+      out.wi = d / dist;
+      out.distance = dist;
+      out.pdf = 1.0f;
+      Rgb i = light.intensity;
+      if (light.type == Light::Type::Spot) {
+        Vec3f axis = normalize(m.vector(light.direction));
+        float f = light.spotFalloff(dot(-out.wi, axis));
+        if (f <= 0) return false;
+        i = i * f;
+      }
+      out.li = i / dist2;
+      return true;
+    }
+    case Light::Type::Directional: {
+      Affine3f m = light.motion.atNormalized(time01);
+      out.wi = -normalize(m.vector(light.direction));
+      out.distance = std::numeric_limits<float>::infinity();
+      out.li = light.power;
+      out.pdf = 1.0f;
+      return true;
+    }
+    case Light::Type::Area: {
+      AreaLightFrame f = areaLightFrame(light, time01);
+      Vec3f q = f.center + f.edgeX * (u.x - 0.5f) + f.edgeZ * (u.y - 0.5f);
+      Vec3f d = q - p;
+      float dist2 = lengthSquared(d);
+      if (!(dist2 > 0)) return false;
+      float dist = std::sqrt(dist2);
+      out.wi = d / dist;
+      out.distance = dist;
+      out.li = areaLightRadiance(light, f, -out.wi);
+      if (out.li.isBlack()) return false;
+      out.pdf = areaLightPdf(light, f, p, q);
+      return out.pdf > 0;
+    }
+  }
+  return false;
+}
+
+}  // namespace tdpm

@@ -1,0 +1,57 @@
+// scene/light.h — the closed set of light sources (point, spot, directional,
+// rectangular area), each of which may move, with sampling for next-event
+// estimation. Photon emission sampling lives beside them (emitPhoton) so the
+// photon tracer and the path tracer share one definition of every light.
+#pragma once
+#include <cstdint>
+
+#include "math/bounds.h"
+#include "math/vec.h"
+#include "motion/motion.h"
+
+namespace tdpm {
+
+struct Light {
+  enum class Type : uint8_t { Point, Spot, Directional, Area };
+  Type type = Type::Point;
+  Rgb power{0.0f};           // W (point, spot, area); W/m^2 irradiance (directional)
+  Rgb intensity{0.0f};       // point, spot: W/sr on the axis
+  Vec3f position{0, 0, 0};   // point, spot: before motion
+  Vec3f direction{0, -1, 0}; // spot axis, directional travel direction: before motion
+  float cosTotal = 0.0f, cosFalloffStart = 1.0f;  // spot
+  Vec2f size{1, 1};          // area: local x-z rectangle, emits toward local -y
+  Motion motion;             // light-to-world over the shutter
+  uint32_t geometryId = ~0u; // area: its Embree geometry
+
+  bool isDelta() const { return type != Type::Area; }
+  // Spot falloff: 1 inside the inner cone, 0 outside the outer cone and a
+  // quartic blend between (pbrt-v3's smoothstep-free form).
+  float spotFalloff(float cosTheta) const;
+};
+
+// Derived constants (intensity from power; spot solid-angle integral).
+void finalizeLight(Light& light);
+
+struct AreaLightFrame {
+  Vec3f center, edgeX, edgeZ, normal;  // world, at one time; normal = emitting side
+  float area;
+};
+AreaLightFrame areaLightFrame(const Light& light, float time01);
+// Emitted radiance of an area light toward direction -wiToLight from the
+// light's surface, when its emitting side faces it.
+Rgb areaLightRadiance(const Light& light, const AreaLightFrame& f, Vec3f dirFromLight);
+
+struct LightSample {
+  Vec3f wi;            // unit, from the shading point toward the light
+  float distance = 0;  // to the sampled point (infinity: directional)
+  Rgb li{0.0f};        // incident radiance (area) or intensity / d^2 (delta)
+  float pdf = 0;       // solid angle (area); 1 for delta lights
+};
+
+// Next-event estimation sample from shading point p at normalised time u01.
+bool sampleLight(const Light& light, Vec3f p, float time01, Vec2f u, LightSample& out);
+// Solid-angle density with which sampleLight would have chosen the point
+// `hit` on an area light (for MIS when a BSDF-sampled ray hits it).
+float areaLightPdf(const Light& light, const AreaLightFrame& f, Vec3f p, Vec3f hit);
+
+}  // namespace tdpm

@@ -1,0 +1,50 @@
+// scene/scene.cpp — ray queries returning shaded hit records.
+#include "scene/scene.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tdpm {
+
+float Scene::epsilon(Vec3f p) const {
+  // Relative to both the point's magnitude (float spacing grows with it) and
+  // the scene's size, so a scene scaled by 1e-3 or 1e3 behaves the same.
+  float m = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z), 1e-2f * sceneScale_});
+  return 2e-5f * m;
+}
+
+Vec3f Scene::spawnOrigin(Vec3f p, Vec3f n, Vec3f d) const {
+  return p + faceForward(n, d) * epsilon(p);
+}
+
+bool Scene::intersect(Vec3f o, Vec3f d, float tFar, float time01, Hit& hit) const {
+  RawHit raw;
+  if (!embree_.intersect(o, d, tFar, time01, raw)) return false;
+  hit.t = raw.t;
+  hit.p = o + d * raw.t;
+  int32_t owner = geometryOwner_[raw.geometryId];
+  if (owner < 0) {
+    hit.light = -owner - 1;
+    hit.object = 0;
+    hit.n = areaLightFrame(lights[size_t(hit.light)], time01).normal * -1.0f;  // quad's geometric +y side
+    hit.localP = hit.p;
+    return true;
+  }
+  hit.light = -1;
+  hit.object = uint32_t(owner);
+  const SceneObject& obj = objects[size_t(owner)];
+  Affine3f m = obj.motion.atNormalized(time01);
+  if (obj.kind == SceneObject::Kind::Sphere) {
+    hit.n = normalize(hit.p - m.point({0, 0, 0}));
+  } else {
+    hit.n = normalize(m.normal(obj.faceNormals[raw.primitiveId]));
+  }
+  hit.localP = m.inverse().point(hit.p);
+  return true;
+}
+
+bool Scene::occluded(Vec3f o, Vec3f d, float tFar, float time01) const {
+  return embree_.occluded(o, d, tFar, time01);
+}
+
+}  // namespace tdpm

@@ -1,0 +1,70 @@
+// scene/scene.h — the built scene every later stage reads: camera, shutter,
+// materials, lights, objects with their motion and swept bounds, and ray
+// queries (through EmbreeScene) that return fully shaded hit records.
+// Built once per render from a validated SceneDescription; read-only after.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "math/bounds.h"
+#include "motion/motion.h"
+#include "scene/camera.h"
+#include "scene/description.h"
+#include "scene/embree_scene.h"
+#include "scene/light.h"
+#include "scene/material.h"
+
+namespace tdpm {
+
+struct SceneObject {
+  enum class Kind : uint8_t { Sphere, Triangles };
+  std::string name;
+  Kind kind = Kind::Triangles;
+  uint32_t material = 0;
+  Motion motion;                    // object-to-world over the shutter
+  Bounds3f objectBounds;            // object space
+  Bounds3f sweptBounds;             // world, over the whole shutter
+  std::vector<Vec3f> faceNormals;   // triangles: object-space unit normals
+};
+
+struct Hit {
+  float t = 0;
+  Vec3f p;             // world position
+  Vec3f n;             // outward geometric normal, world, unit
+  Vec3f localP;        // object-space position (textures)
+  uint32_t object = 0; // index into objects (when !isLight)
+  int32_t light = -1;  // index into lights when an area light was hit
+  bool isLight() const { return light >= 0; }
+};
+
+class Scene {
+ public:
+  static std::unique_ptr<Scene> build(const scene::SceneDescription& desc);
+
+  // Closest hit along o + s d, s in (0, tFar), at normalised time time01.
+  bool intersect(Vec3f o, Vec3f d, float tFar, float time01, Hit& hit) const;
+  bool occluded(Vec3f o, Vec3f d, float tFar, float time01) const;
+  // Origin for a ray leaving surface point p (normal n) in direction d:
+  // pushed off the surface by a distance relative to the scene's scale.
+  Vec3f spawnOrigin(Vec3f p, Vec3f n, Vec3f d) const;
+  float epsilon(Vec3f p) const;
+
+  Camera camera;
+  Shutter shutter;
+  std::vector<Material> materials;
+  std::vector<SceneObject> objects;
+  std::vector<Light> lights;
+  Rgb background{0.0f};
+  Bounds3f bounds;                    // everything, over the whole shutter
+  std::vector<Bounds3f> movingBounds; // swept bounds of each moving object / area light
+  bool hasMotion = false;             // any moving object, light or camera
+
+ private:
+  EmbreeScene embree_;
+  // Embree geometry id -> object index (>= 0) or -(light index) - 1.
+  std::vector<int32_t> geometryOwner_;
+  float sceneScale_ = 1.0f;
+};
+
+}  // namespace tdpm
