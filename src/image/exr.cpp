@@ -1,0 +1,201 @@
+// image/exr.cpp — the only file in tdpm that touches OpenEXR (3.1 C++ API).
+// Every OpenEXR (Iex) exception is turned into tdpm::Error "<path>: <why>"
+// here, so a corrupt input can never abort a `compare` run.
+#include "image/exr.h"
+
+#include <sys/stat.h>
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfPartType.h>
+#include <Imath/ImathBox.h>
+
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <new>
+#include <set>
+
+#include "core/atomic_file.h"
+
+namespace tdpm::image {
+namespace {
+
+static_assert(sizeof(Rgb) == 3 * sizeof(float), "Rgb must be three packed floats: EXR slices stride over it");
+
+// A corrupt header can claim any data window; refuse absurd sizes before
+// allocating (16k x 8k is far beyond anything tdpm renders or compares).
+constexpr int64_t kMaxPixels = int64_t(1) << 27;
+
+bool isColorName(const std::string& n) { return n == "R" || n == "G" || n == "B"; }
+
+// Checks the things OpenEXR reports badly (or not at all): existence,
+// readability, directories, and the magic number, so the user gets
+// "No such file or directory" / "not an OpenEXR file" instead of Iex text.
+void precheckInput(const std::string& path) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0) {
+    int err = errno;
+    throw Error(path + ": " + std::strerror(err));
+  }
+  if (S_ISDIR(st.st_mode)) throw Error(path + ": is a directory, not an OpenEXR file");
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) {
+    int err = errno;
+    throw Error(path + ": " + std::strerror(err));
+  }
+  unsigned char magic[4] = {0, 0, 0, 0};
+  size_t n = std::fread(magic, 1, 4, f);
+  std::fclose(f);
+  // EXR magic number 20000630 = 0x01312f76, stored little-endian.
+  const unsigned char expected[4] = {0x76, 0x2f, 0x31, 0x01};
+  if (n < 4 || std::memcmp(magic, expected, 4) != 0)
+    throw Error(path + ": not an OpenEXR file (bad magic number)");
+}
+
+}  // namespace
+
+const Channel* ExrFile::findChannel(const std::string& name) const {
+  for (const Channel& c : extra)
+    if (c.name == name) return &c;
+  return nullptr;
+}
+
+// ---- writing ----
+
+void writeExr(const std::string& path, const ExrFile& file) {
+  const ImageRgb& img = file.color;
+  TDPM_ASSERT(!img.empty(), "writeExr: empty image");
+  TDPM_ASSERT(img.pixels.size() == img.pixelCount(), "writeExr: pixel count does not match size");
+  std::set<std::string> names{"R", "G", "B"};
+  for (const Channel& c : file.extra) {
+    TDPM_ASSERT(!c.name.empty(), "writeExr: unnamed extra channel");
+    TDPM_ASSERT(names.insert(c.name).second, "writeExr: duplicate channel name " + c.name);
+    TDPM_ASSERT(c.values.size() == img.pixelCount(), "writeExr: channel " + c.name + " has the wrong length");
+  }
+
+  // Created first: a missing or read-only directory fails here, in our words.
+  AtomicFile out(path);
+  try {
+    Imf::Header header(img.width, img.height);
+    header.compression() = Imf::ZIP_COMPRESSION;  // lossless, ~2x on renders
+    header.lineOrder() = Imf::INCREASING_Y;       // row 0 = top, as ImageRgb
+    for (const auto& [key, value] : file.metadata) header.insert(key, Imf::StringAttribute(value));
+
+    Imf::FrameBuffer fb;
+    const size_t rgbX = sizeof(Rgb), rgbY = sizeof(Rgb) * size_t(img.width);
+    // OpenEXR's Slice wants a non-const pointer even for writing; it only reads.
+    char* base = reinterpret_cast<char*>(const_cast<Rgb*>(img.pixels.data()));
+    const char* rgbNames[3] = {"R", "G", "B"};
+    for (int c = 0; c < 3; ++c) {
+      header.channels().insert(rgbNames[c], Imf::Channel(Imf::FLOAT));
+      fb.insert(rgbNames[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), rgbX, rgbY));
+    }
+    for (const Channel& c : file.extra) {
+      header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
+      char* p = reinterpret_cast<char*>(const_cast<float*>(c.values.data()));
+      fb.insert(c.name, Imf::Slice(Imf::FLOAT, p, sizeof(float), sizeof(float) * size_t(img.width)));
+    }
+    {
+      // Scope: the OutputFile destructor writes the line offset table, so it
+      // must be closed before the rename.
+      Imf::OutputFile exr(out.tempPath().c_str(), header);
+      exr.setFrameBuffer(fb);
+      exr.writePixels(img.height);
+    }
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw Error(path + ": cannot write OpenEXR file: " + e.what());
+  }
+  out.commit();
+}
+
+// ---- reading ----
+
+ExrFile readExr(const std::string& path) {
+  precheckInput(path);
+  ExrFile result;
+  try {
+    Imf::InputFile in(path.c_str());
+    const Imf::Header& header = in.header();
+    if (header.hasType() && Imf::isDeepData(header.type()))
+      throw Error(path + ": deep OpenEXR images are not supported");
+
+    const Imath::Box2i dw = header.dataWindow();
+    const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, h = int64_t(dw.max.y) - dw.min.y + 1;
+    if (w <= 0 || h <= 0) throw Error(path + ": empty data window");
+    if (w * h > kMaxPixels)
+      throw Error(path + ": image too large (" + std::to_string(w) + "x" + std::to_string(h) + ")");
+    const size_t npix = size_t(w) * size_t(h);
+
+    // Which channels we can read: full resolution only.
+    const Imf::ChannelList& channels = header.channels();
+    auto fullRes = [&](const char* name) {
+      const Imf::Channel* c = channels.findChannel(name);
+      return c && c->xSampling == 1 && c->ySampling == 1;
+    };
+    const bool hasRgb = fullRes("R") && fullRes("G") && fullRes("B");
+    const bool hasY = !hasRgb && fullRes("Y");
+    if (!hasRgb && !hasY) {
+      std::string present;
+      for (auto it = channels.begin(); it != channels.end(); ++it)
+        present += std::string(present.empty() ? "" : ", ") + it.name();
+      throw Error(path + ": no R, G, B (or Y) channels; the file has: " + (present.empty() ? "none" : present));
+    }
+
+    result.color = ImageRgb(int(w), int(h));
+    std::vector<float> grey;
+    Imf::FrameBuffer fb;
+    // Slice::Make offsets the base pointer by the data window origin, so a
+    // window not starting at (0,0) (crops from other tools) lands at index 0.
+    char* base = reinterpret_cast<char*>(result.color.pixels.data());
+    const size_t rgbX = sizeof(Rgb), rgbY = sizeof(Rgb) * size_t(w);
+    if (hasRgb) {
+      const char* rgbNames[3] = {"R", "G", "B"};
+      for (int c = 0; c < 3; ++c)
+        fb.insert(rgbNames[c], Imf::Slice::Make(Imf::FLOAT, base + c * sizeof(float), dw, rgbX, rgbY));
+    } else {
+      grey.resize(npix);
+      fb.insert("Y", Imf::Slice::Make(Imf::FLOAT, grey.data(), dw, sizeof(float), sizeof(float) * size_t(w)));
+    }
+    for (auto it = channels.begin(); it != channels.end(); ++it) {
+      const std::string name = it.name();
+      if (hasRgb ? isColorName(name) : name == "Y") continue;
+      const Imf::Channel& ch = it.channel();
+      if (ch.xSampling != 1 || ch.ySampling != 1) continue;
+      result.extra.push_back(Channel{name, std::vector<float>(npix)});
+    }
+    // Insert after the vector stopped growing: pointers must stay valid.
+    for (Channel& c : result.extra)
+      fb.insert(c.name, Imf::Slice::Make(Imf::FLOAT, c.values.data(), dw, sizeof(float), sizeof(float) * size_t(w)));
+
+    in.setFrameBuffer(fb);
+    if (!in.isComplete()) throw Error(path + ": truncated OpenEXR file (missing pixel data)");
+    in.readPixels(dw.min.y, dw.max.y);
+
+    if (hasY)
+      for (size_t i = 0; i < npix; ++i) result.color.pixels[i] = Rgb(grey[i]);
+
+    for (auto it = header.begin(); it != header.end(); ++it)
+      if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+        result.metadata[it.name()] = s->value();
+  } catch (const Error&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw Error(path + ": out of memory reading OpenEXR file");
+  } catch (const std::exception& e) {
+    throw Error(path + ": cannot read OpenEXR file: " + e.what());
+  } catch (...) {
+    throw Error(path + ": cannot read OpenEXR file (unknown error)");
+  }
+  return result;
+}
+
+}  // namespace tdpm::image

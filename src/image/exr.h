@@ -1,0 +1,52 @@
+// image/exr.h — OpenEXR files: the renderer's output and `compare`'s input.
+// Owns: ExrFile (colour + extra per-pixel float layers + string metadata),
+// writeExr, readExr. image/exr.cpp is the only file that includes OpenEXR;
+// callers never see Imf/Iex types or exceptions.
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+#include "image/image.h"
+
+namespace tdpm::image {
+
+// One float per pixel, same layout as ImageRgb::pixels (row-major, y down).
+// Names follow EXR layer conventions: "spp", "variance.R", "variance.G", ...
+struct Channel {
+  std::string name;
+  std::vector<float> values;
+};
+
+struct ExrFile {
+  ImageRgb color;
+  std::vector<Channel> extra;
+  // String attributes, e.g. "tdpm/scene", "tdpm/method", "tdpm/spp",
+  // "tdpm/seed", "tdpm/render_seconds". On reading: every string attribute
+  // of the header (also foreign ones such as "owner" or "comments").
+  std::map<std::string, std::string> metadata;
+
+  // The extra channel called `name`, or nullptr.
+  const Channel* findChannel(const std::string& name) const;
+};
+
+// Writes 32-bit float R, G, B plus every extra channel as FLOAT, ZIP
+// compressed, metadata as string attributes. Atomic: the file at `path`
+// either is complete or was not touched. Throws tdpm::Error "<path>: ...".
+// Inconsistent input (empty image, channel of the wrong length, duplicate
+// or reserved channel names) is a bug: TDPM_ASSERT.
+void writeExr(const std::string& path, const ExrFile& file);
+
+// Reads the data window of a flat (scanline or tiled) EXR, first part:
+//  * colour from R, G, B (any pixel type, converted to float); an image with
+//    Y and no R/G/B reads as grey (R = G = B = Y);
+//  * every other full-resolution channel (HALF, FLOAT or UINT) as `extra`,
+//    in the file's (alphabetical) channel order; sub-sampled channels
+//    (e.g. luma/chroma RY, BY) are skipped;
+//  * all string attributes as metadata.
+// Any failure (missing or unreadable file, not an EXR, truncated or
+// corrupt data, deep image, no colour channels) throws tdpm::Error
+// "<path>: <reason>"; OpenEXR's own exceptions never escape.
+ExrFile readExr(const std::string& path);
+
+}  // namespace tdpm::image

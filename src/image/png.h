@@ -1,0 +1,42 @@
+// image/png.h — the 8-bit sRGB PNG preview written beside every EXR, and
+// the path rule that puts it there. image/png.cpp is the only user of libpng.
+// The preview is for eyes only: every measurement reads the EXR.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "image/image.h"
+
+namespace tdpm::image {
+
+// An 8-bit RGB raster (row-major, y down, 3 bytes per pixel).
+struct ImageRgb8 {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;  // width * height * 3
+};
+
+// sRGB opto-electronic transfer function (IEC 61966-2-1) on [0,1].
+float srgbEncode(float linear);
+// Display encoding of one linear value: NaN and negatives -> 0, values >= 1
+// clamp to 255, then the sRGB OETF and rounding to nearest.
+uint8_t toSrgb8(float linear);
+
+// Tone maps (scale by 2^exposureStops, clamp, sRGB OETF) to 8 bits.
+ImageRgb8 toPreview(const ImageRgb& image, float exposureStops);
+
+// Writes toPreview(image, exposureStops) as an 8-bit RGB PNG with an sRGB
+// chunk, atomically. Throws tdpm::Error "<path>: <reason>".
+void writePngPreview(const std::string& path, const ImageRgb& image, float exposureStops);
+
+// Reads any PNG as 8-bit RGB (tests, and a preview check). Throws
+// tdpm::Error "<path>: <reason>".
+ImageRgb8 readPng(const std::string& path);
+
+// The preview's path for an output path: the extension of the last path
+// component replaced by ".png" ("out.exr" -> "out.png", "dir.v2/out" ->
+// "dir.v2/out.png", ".hidden" -> ".hidden.png"). If the output itself ends
+// in ".png" the preview becomes "<stem>.preview.png", never the same file.
+std::string previewPathFor(const std::string& outputPath);
+
+}  // namespace tdpm::image
