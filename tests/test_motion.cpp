@@ -15,10 +15,10 @@ TEST_CASE("motion: keyframes at aligned times are reproduced exactly") {
   keys[1] = {0.25f, {1, 0, 0}, {}, {1, 1, 1}};
   keys[2] = {1.0f, {1, 2, 0}, {}, {2, 2, 2}};
   Shutter sh{0, 1};
-  Motion m = Motion::keyframed(Affine3f::identity(), keys, sh);
+  Motion m = Motion::keyframed(MotionKey{}, keys, sh);
   CHECK(m.stepCount() == 5);  // smallest grid with 0.25 on it
   for (float t : {0.0f, 0.1f, 0.25f, 0.6f, 1.0f}) {
-    Affine3f a = m.atNormalized(t), b = Motion::interpolateKeys(keys, t);
+    Affine3f a = m.atNormalized(t), b = Motion::poseAt(MotionKey{}, keys, t);
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 4; ++j) CHECK(a.m[i][j] == doctest::Approx(b.m[i][j]).epsilon(1e-5));
   }
@@ -28,7 +28,7 @@ TEST_CASE("motion: rotation is subdivided so the blended chord stays on the arc"
   std::vector<MotionKey> keys(2);
   keys[0] = {0.0f, {0, 0, 0}, Quaternion::fromAxisAngle({0, 0, 1}, 0), {1, 1, 1}};
   keys[1] = {1.0f, {0, 0, 0}, Quaternion::fromAxisAngle({0, 0, 1}, kPi / 2), {1, 1, 1}};
-  Motion m = Motion::keyframed(Affine3f::identity(), keys, {0, 1});
+  Motion m = Motion::keyframed(MotionKey{}, keys, {0, 1});
   CHECK(m.stepCount() >= 46);  // 90 degrees / 2 degrees per step
   for (int i = 0; i <= 100; ++i) {
     float u = float(i) / 100.0f;
@@ -43,7 +43,7 @@ TEST_CASE("motion: swept bounds contain the object at every time") {
   std::vector<MotionKey> keys(2);
   keys[0] = {0.0f, {-2, 0, 0}, {}, {1, 1, 1}};
   keys[1] = {1.0f, {3, 1, 0}, Quaternion::fromAxisAngle({1, 1, 0}, 2.0f), {1, 1, 1}};
-  Motion m = Motion::keyframed(Affine3f::identity(), keys, {0, 1});
+  Motion m = Motion::keyframed(MotionKey{}, keys, {0, 1});
   Bounds3f local{{-0.5f, -0.5f, -0.5f}, {0.5f, 0.5f, 0.5f}};
   Bounds3f swept = m.sweptBounds(local);
   for (int i = 0; i <= 50; ++i) {
@@ -112,4 +112,25 @@ TEST_CASE("motion: a rotating and translating box (mesh) is hit where the transf
     Hit h;
     CHECK_FALSE(hitAt(*s, outside.x, outside.y, t, h));
   }
+}
+
+TEST_CASE("motion: keyframe rotation spins an object about its own placed centre") {
+  std::vector<MotionKey> keys(2);
+  keys[0] = {0.0f, {0, 0, 0}, {}, {1, 1, 1}};
+  keys[1] = {1.0f, {2, 0, 0}, Quaternion::fromAxisAngle({0, 0, 1}, kPi / 2), {2, 2, 2}};
+  MotionKey placement{0.0f, {0, 1, 0}, Quaternion::fromAxisAngle({0, 1, 0}, kPi / 2), {1, 1, 1}};
+  Motion m = Motion::keyframed(placement, keys, {0, 1});
+  for (float u : {0.0f, 0.3f, 1.0f}) {
+    // The centre only translates: from (0,1,0) along world x.
+    Vec3f c = m.atNormalized(u).point({0, 0, 0});
+    CHECK(c.x == doctest::Approx(2.0f * u).epsilon(1e-4));
+    CHECK(c.y == doctest::Approx(1.0f).epsilon(1e-4));
+    CHECK(std::fabs(c.z) < 1e-4f);
+  }
+  // At the end: local +z -> (placement: 90 deg about y) +x -> (key: 90 deg
+  // about z) +y, scaled by 2, around the centre (2, 1, 0).
+  Vec3f p = m.atNormalized(1.0f).point({0, 0, 1});
+  CHECK(std::fabs(p.x - 2.0f) < 1e-4f);
+  CHECK(p.y == doctest::Approx(3.0f).epsilon(1e-4));
+  CHECK(std::fabs(p.z) < 1e-4f);
 }

@@ -14,17 +14,21 @@ Motion Motion::still(const Affine3f& placement) {
   return m;
 }
 
-Affine3f Motion::interpolateKeys(const std::vector<MotionKey>& keys, float time) {
+MotionKey Motion::interpolateKeys(const std::vector<MotionKey>& keys, float time) {
   TDPM_ASSERT(!keys.empty(), "no keyframes");
-  auto pose = [](const MotionKey& k) { return Affine3f::fromTRS(k.translate, k.rotate, k.scale); };
-  if (time <= keys.front().time) return pose(keys.front());
-  if (time >= keys.back().time) return pose(keys.back());
+  if (time <= keys.front().time) return keys.front();
+  if (time >= keys.back().time) return keys.back();
   size_t i = 1;
   while (keys[i].time < time) ++i;
   const MotionKey& a = keys[i - 1];
   const MotionKey& b = keys[i];
   float s = (time - a.time) / (b.time - a.time);
-  return Affine3f::fromTRS(lerp(a.translate, b.translate, s), slerp(a.rotate, b.rotate, s), lerp(a.scale, b.scale, s));
+  return {time, lerp(a.translate, b.translate, s), slerp(a.rotate, b.rotate, s), lerp(a.scale, b.scale, s)};
+}
+
+Affine3f Motion::poseAt(const MotionKey& p, const std::vector<MotionKey>& keys, float time) {
+  MotionKey k = interpolateKeys(keys, time);
+  return Affine3f::fromTRS(p.translate + k.translate, k.rotate * p.rotate, k.scale * p.scale);
 }
 
 namespace {
@@ -45,9 +49,9 @@ int alignedIntervalCount(const std::vector<float>& u, int minN) {
 
 }  // namespace
 
-Motion Motion::keyframed(const Affine3f& placement, const std::vector<MotionKey>& keys, const Shutter& shutter) {
+Motion Motion::keyframed(const MotionKey& placement, const std::vector<MotionKey>& keys, const Shutter& shutter) {
   TDPM_ASSERT(keys.size() >= 2, "keyframed motion needs two keys");
-  if (shutter.instant()) return still(interpolateKeys(keys, shutter.open) * placement);
+  if (shutter.instant()) return still(poseAt(placement, keys, shutter.open));
 
   std::vector<float> u;
   u.reserve(keys.size());
@@ -67,7 +71,7 @@ Motion Motion::keyframed(const Affine3f& placement, const std::vector<MotionKey>
   m.steps_.resize(size_t(n) + 1);
   for (int i = 0; i <= n; ++i) {
     float t = shutter.fromNormalized(float(i) / float(n));
-    m.steps_[size_t(i)] = interpolateKeys(keys, t) * placement;
+    m.steps_[size_t(i)] = poseAt(placement, keys, t);
   }
   return m;
 }

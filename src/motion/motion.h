@@ -35,9 +35,16 @@ class Motion {
   Motion() : steps_{Affine3f::identity()} {}
   // A placement that never moves.
   static Motion still(const Affine3f& placement);
-  // world(t) = keyframes(t) * placement. keys: >= 2, times strictly
-  // increasing inside the shutter (the parser guarantees it).
-  static Motion keyframed(const Affine3f& placement, const std::vector<MotionKey>& keys, const Shutter& shutter);
+  // Keyframed motion on top of a placement (placement.time is ignored):
+  //   world(t) = Translate(P.t + k.t(t)) * Rotate(k.r(t) * P.r) * Scale(k.s(t) * P.s)
+  // i.e. keyframe translations move the object along world axes, keyframe
+  // rotations and scales act about the object's own placed centre (not the
+  // world origin). keys: >= 2, times strictly increasing inside the
+  // shutter (the parser guarantees it).
+  static Motion keyframed(const MotionKey& placement, const std::vector<MotionKey>& keys, const Shutter& shutter);
+  // The pose the rule above gives at scene time t (between the steps the
+  // renderer blends; exact at the steps).
+  static Affine3f poseAt(const MotionKey& placement, const std::vector<MotionKey>& keys, float time);
 
   bool moving() const { return steps_.size() > 1; }
   int stepCount() const { return int(steps_.size()); }
@@ -49,9 +56,9 @@ class Motion {
   // blended motion: a point's path is piecewise linear between the steps.
   Bounds3f sweptBounds(const Bounds3f& objectBounds) const;
 
-  // The keyframe pose interpolation (linear / slerp / linear), exposed for
-  // tests and for anything that needs the pose between steps.
-  static Affine3f interpolateKeys(const std::vector<MotionKey>& keys, float time);
+  // The keyframe interpolation (translation and scale linear, rotation
+  // slerp; end poses held outside the keys).
+  static MotionKey interpolateKeys(const std::vector<MotionKey>& keys, float time);
 
  private:
   std::vector<Affine3f> steps_;

@@ -6,35 +6,13 @@
 #include <limits>
 
 #include "sampling/warp.h"
+#include "render/direct_light.h"
 #include "scene/bsdf.h"
 
 namespace tdpm {
 
 namespace {
 constexpr int kRouletteStartDepth = 3;
-}
-
-Rgb PathTracer::directLight(const Hit& hit, const ShadingContext& ctx, float time01, Rng& rng) const {
-  Rgb sum(0.0f);
-  for (const Light& light : scene_.lights) {
-    LightSample ls;
-    Vec2f u{rng.uniform(), rng.uniform()};
-    if (!sampleLight(light, hit.p, time01, u, ls)) continue;
-    Rgb f = bsdfEval(ctx, ls.wi);
-    if (f.isBlack()) continue;
-    float cosTheta = std::fabs(dot(ls.wi, ctx.frame.n));
-    Vec3f o = scene_.spawnOrigin(hit.p, hit.n, ls.wi);
-    // Stop short of the light's own surface (area lights are geometry).
-    float tMax = std::isinf(ls.distance) ? ls.distance : ls.distance * (1.0f - 1e-4f) - scene_.epsilon(hit.p);
-    if (tMax <= 0 || scene_.occluded(o, ls.wi, tMax, time01)) continue;
-    if (light.isDelta()) {
-      sum += f * ls.li * cosTheta;
-    } else {
-      float w = powerHeuristic(ls.pdf, bsdfPdf(ctx, ls.wi));
-      sum += f * ls.li * (cosTheta * w / ls.pdf);
-    }
-  }
-  return sum;
 }
 
 Rgb PathTracer::radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const {
@@ -63,7 +41,7 @@ Rgb PathTracer::radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const 
     ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
 
     // ---- next-event estimation ----
-    if (!mat.isDeltaOnly()) L += beta * directLight(hit, ctx, time01, rng);
+    if (!mat.isDeltaOnly()) L += beta * directLight(scene_, hit, ctx, time01, rng, /*misWithBsdf=*/true);
 
     // ---- continue the path ----
     BsdfSample bs;

@@ -16,10 +16,12 @@ class PathTracer {
   PathTracer(const Scene& scene, int maxDepth) : scene_(scene), maxDepth_(maxDepth) {}
 
   // Radiance arriving at `origin` from direction `dir`, at time time01.
+  struct ThreadState {};
+  Rgb radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng, ThreadState&) const { return radiance(origin, dir, time01, rng); }
   Rgb radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const;
+  void flush(ThreadState&) const {}
 
  private:
-  Rgb directLight(const Hit& hit, const struct ShadingContext& ctx, float time01, Rng& rng) const;
 
   const Scene& scene_;
   int maxDepth_;

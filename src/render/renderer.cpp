@@ -1,13 +1,18 @@
-// render/renderer.cpp — per-pixel sampling over the tile loop.
+// render/renderer.cpp — methods, adaptive per-pixel sampling over the tile
+// loop, and the accumulation buffer.
 #include "render/renderer.h"
 
-#include <cstring>
+#include <algorithm>
+#include <cmath>
+#include <memory>
 #include <vector>
 
 #include "core/error.h"
 #include "core/rng.h"
 #include "core/timer.h"
 #include "render/path_tracer.h"
+#include "render/photon_integrator.h"
+#include "render/photon_map.h"
 #include "render/tile_loop.h"
 #include "sampling/stratified.h"
 
@@ -17,50 +22,144 @@ namespace {
 
 const char* const kMethods[] = {"pathtrace", "static", "accumulation", "standard", "time", nullptr};
 
-struct PixelScratch {
-  std::vector<CameraSample> samples;
-  std::vector<uint32_t> strata;
-};
-
-// Streams the samples of one pixel into a mean and the variance of that
-// mean (Welford's update: stable in one pass).
+// Streams a pixel's samples into a mean and the variance of that mean
+// (Welford's update: stable in one pass), plus luminance statistics for
+// the adaptive stopping rule.
 struct PixelAccumulator {
   Rgb mean{0.0f}, m2{0.0f};
+  double lumMean = 0, lumM2 = 0;
   int n = 0;
   void add(Rgb v) {
     ++n;
     Rgb d = v - mean;
     mean += d / float(n);
     m2 += d * (v - mean);
+    double l = v.luminance(), dl = l - lumMean;
+    lumMean += dl / n;
+    lumM2 += dl * (l - lumMean);
   }
   Rgb varianceOfMean() const { return n > 1 ? m2 / (float(n) * float(n - 1)) : Rgb(0.0f); }
+  // Contrast: the standard error of the mean luminance relative to the mean
+  // (plus a floor, so near-black pixels are judged on absolute error).
+  double contrast() const {
+    if (n < 2) return std::numeric_limits<double>::infinity();
+    double se = std::sqrt(std::max(0.0, lumM2 / (double(n) * double(n - 1))));
+    return se / (std::fabs(lumMean) + kContrastFloor);
+  }
+  static constexpr double kContrastFloor = 0.02;
+};
+
+struct SamplingPlan {
+  int batch = 16, maxSpp = 16;
+  float contrast = 0.05f;
+  uint64_t seed = 1;
+  bool sampleTime = true;       // false: a scene without motion draws no times
+  float fixedTime01 = -1.0f;    // >= 0: every sample at this time (accumulation frames)
 };
 
 template <class Integrator>
-void renderPixels(const Scene& scene, const Integrator& integrator, const RenderOptions& opt, const Progress& progress,
-                  Film& film) {
+struct PixelScratch {
+  std::vector<CameraSample> samples;
+  std::vector<uint32_t> strata;
+  typename Integrator::ThreadState state;
+};
+
+template <class Integrator>
+void renderPixels(const Scene& scene, const Integrator& integrator, const SamplingPlan& plan, const char* stage,
+                  const Progress& progress, Film& film) {
   const Camera& cam = scene.camera;
-  forEachTile<PixelScratch>(film.width, film.height, "render", progress, [&](const Tile& t, PixelScratch& s) {
-    s.samples.resize(size_t(opt.spp));
+  forEachTile<PixelScratch<Integrator>>(film.width, film.height, stage, progress,
+                                        [&](const Tile& t, PixelScratch<Integrator>& s) {
+    s.samples.resize(size_t(plan.batch));
     for (int y = t.y0; y < t.y1; ++y)
       for (int x = t.x0; x < t.x1; ++x) {
         size_t idx = film.index(x, y);
-        Rng rng(hashCombine(opt.seed, idx), 0);
-        stratifiedCameraSamples(opt.spp, rng, s.samples.data(), s.strata);
+        Rng rng(hashCombine(plan.seed, idx), 0);
         PixelAccumulator acc;
-        for (const CameraSample& cs : s.samples) {
-          Vec3f o, d;
-          cam.generateRay({float(x) + cs.pixelOffset.x, float(y) + cs.pixelOffset.y}, cs.time01, o, d);
-          Rgb L = integrator.radiance(o, d, cs.time01, rng);
-          // A NaN/Inf sample is a bug upstream; never let it reach the film.
-          if (!isFinite(L)) L = Rgb(0.0f);
-          acc.add(L);
+        for (;;) {
+          stratifiedCameraSamples(plan.batch, rng, s.samples.data(), s.strata);
+          for (CameraSample& cs : s.samples) {
+            if (plan.fixedTime01 >= 0) cs.time01 = plan.fixedTime01;
+            else if (!plan.sampleTime) cs.time01 = 0.0f;
+            Vec3f o, d;
+            cam.generateRay({float(x) + cs.pixelOffset.x, float(y) + cs.pixelOffset.y}, cs.time01, o, d);
+            Rgb L = integrator.radiance(o, d, cs.time01, rng, s.state);
+            // A NaN/Inf sample is a bug upstream; never let it reach the film.
+            if (!isFinite(L)) L = Rgb(0.0f);
+            acc.add(L);
+          }
+          if (acc.n + plan.batch > plan.maxSpp || acc.contrast() <= plan.contrast) break;
         }
         film.color[idx] = acc.mean;
         film.sampleCount[idx] = float(acc.n);
         film.varianceOfMean[idx] = acc.varianceOfMean();
       }
+    integrator.flush(s.state);
   });
+}
+
+float defaultMaxRadius(const Scene& scene, const RenderOptions& opt) {
+  if (std::isfinite(opt.estimate.maxRadius)) return opt.estimate.maxRadius;
+  float diag = scene.bounds.empty() ? 1.0f : length(scene.bounds.diagonal());
+  return opt.maxRadiusFraction * diag;
+}
+
+struct Maps {
+  std::unique_ptr<PhotonMap> caustic, global;
+};
+
+Maps tracePhotonMaps(const Scene& scene, const RenderOptions& opt, size_t causticWanted, size_t globalWanted,
+                     bool spreadInTime, float fixedTime01, uint64_t seed, const Progress& progress, RenderStats& st) {
+  Maps maps;
+  PhotonMapSettings ms;
+  ms.spaceTime = opt.spaceTime4D && spreadInTime;
+  ms.kappa = opt.kappa;
+  ms.trace.seed = seed;
+  ms.trace.maxBounces = opt.maxDepth;
+  ms.trace.spreadInTime = spreadInTime;
+  ms.trace.fixedTime01 = fixedTime01;
+  ms.trace.kind = photon::MapKind::Caustic;
+  ms.trace.storedWanted = causticWanted;
+  maps.caustic = buildPhotonMap(scene, ms, progress);
+  ms.trace.kind = photon::MapKind::Global;
+  ms.trace.storedWanted = opt.visualizeGlobal || opt.gatherRays > 0 ? globalWanted : 0;
+  maps.global = buildPhotonMap(scene, ms, progress);
+  for (const PhotonMap* m : {maps.caustic.get(), maps.global.get()}) {
+    st.photonSeconds += m->traceSeconds + m->buildSeconds;
+    if (!m->warning.empty()) st.warnings.push_back(m->warning);
+  }
+  st.causticStored += maps.caustic->size();
+  st.globalStored += maps.global->size();
+  st.causticEmitted += maps.caustic->emitted;
+  st.globalEmitted += maps.global->emitted;
+  size_t n = maps.caustic->size() + maps.global->size();
+  if (n > 0)
+    st.bytesPerPhoton = (maps.caustic->bytesPerPhoton() * double(maps.caustic->size()) +
+                         maps.global->bytesPerPhoton() * double(maps.global->size())) / double(n);
+  return maps;
+}
+
+PhotonIntegratorSettings integratorSettings(const Scene& scene, const RenderOptions& opt, bool timeDependent) {
+  PhotonIntegratorSettings s;
+  s.timeDependent = timeDependent;
+  s.spaceTime4D = opt.spaceTime4D;
+  s.estimate = opt.estimate;
+  s.estimate.maxRadius = defaultMaxRadius(scene, opt);
+  s.gatherRays = opt.gatherRays;
+  s.visualizeGlobal = opt.visualizeGlobal;
+  s.maxDepth = opt.maxDepth;
+  return s;
+}
+
+void finishStats(const Film& film, RenderStats& st) {
+  st.cameraSamples = 0;
+  st.minSpp = film.sampleCount.empty() ? 0 : int(film.sampleCount[0]);
+  st.maxSpp = st.minSpp;
+  for (float n : film.sampleCount) {
+    st.cameraSamples += uint64_t(n);
+    st.minSpp = std::min(st.minSpp, int(n));
+    st.maxSpp = std::max(st.maxSpp, int(n));
+  }
 }
 
 }  // namespace
@@ -73,19 +172,70 @@ bool isRenderMethod(const std::string& name) {
   return false;
 }
 
-bool methodAvailable(const std::string& name) { return name == "pathtrace"; }
-
-Film render(const Scene& scene, const RenderOptions& opt, const Progress& progress, RenderStats& stats) {
+Film render(const Scene& scene, const RenderOptions& opt, const Progress& progress, RenderStats& st) {
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
   if (!isRenderMethod(opt.method)) throw Error("unknown method '" + opt.method + "'");
-  if (!methodAvailable(opt.method))
-    throw Error("method '" + opt.method + "' needs the photon-map renderer, which this build does not have yet; use pathtrace");
   Timer timer;
+  st = RenderStats{};
   Film film(scene.camera.width(), scene.camera.height());
-  PathTracer pt(scene, opt.maxDepth);
-  renderPixels(scene, pt, opt, progress, film);
-  stats.seconds = timer.seconds();
-  stats.cameraSamples = uint64_t(film.width) * uint64_t(film.height) * uint64_t(opt.spp);
+  SamplingPlan plan;
+  plan.batch = opt.spp;
+  plan.maxSpp = std::max(opt.spp, opt.maxSpp);
+  plan.contrast = opt.contrast;
+  plan.seed = opt.seed;
+  // A scene with no motion at all draws no time samples.
+  plan.sampleTime = scene.hasMotion;
+
+  if (opt.method == "pathtrace") {
+    PathTracer pt(scene, opt.maxDepth);
+    renderPixels(scene, pt, plan, "render", progress, film);
+  } else if (opt.method == "accumulation") {
+    // N in-between frames at equally spaced times, each with its own maps
+    // holding 1/N of the budget, rendered at its own time and averaged.
+    int frames = scene.hasMotion ? std::max(1, opt.frames) : 1;
+    size_t causticPer = (opt.causticPhotons + size_t(frames) - 1) / size_t(frames);
+    size_t globalPer = (opt.globalPhotons + size_t(frames) - 1) / size_t(frames);
+    SamplingPlan framePlan = plan;
+    framePlan.batch = std::max(1, opt.spp / frames);
+    framePlan.maxSpp = std::max(framePlan.batch, plan.maxSpp / frames);
+    Film sum(film.width, film.height);
+    for (int f = 0; f < frames; ++f) {
+      float t01 = (float(f) + 0.5f) / float(frames);
+      Maps maps = tracePhotonMaps(scene, opt, causticPer, globalPer, false, t01, hashCombine(opt.seed, uint64_t(f)),
+                                  progress, st);
+      PhotonIntegrator integ(scene, maps.caustic.get(), maps.global.get(), integratorSettings(scene, opt, false));
+      framePlan.fixedTime01 = t01;
+      framePlan.seed = hashCombine(opt.seed, 0xacc0ull + uint64_t(f));
+      Film one(film.width, film.height);
+      std::string stage = "frame " + std::to_string(f + 1) + "/" + std::to_string(frames);
+      renderPixels(scene, integ, framePlan, stage.c_str(), progress, one);
+      EstimateCounts c = integ.counts();
+      st.standardEstimates += c.standard;
+      for (size_t i = 0; i < sum.color.size(); ++i) {
+        sum.color[i] += one.color[i];
+        sum.sampleCount[i] += one.sampleCount[i];
+        sum.varianceOfMean[i] += one.varianceOfMean[i];
+      }
+    }
+    float inv = 1.0f / float(frames);
+    for (size_t i = 0; i < film.color.size(); ++i) {
+      film.color[i] = sum.color[i] * inv;
+      film.sampleCount[i] = sum.sampleCount[i];
+      film.varianceOfMean[i] = sum.varianceOfMean[i] * (inv * inv);  // var of an average of independent frames
+    }
+  } else {
+    // static: photons at shutter open; standard and time: spread in time.
+    bool spread = opt.method != "static" && scene.hasMotion;
+    bool timeDependent = opt.method == "time" && scene.hasMotion;
+    Maps maps = tracePhotonMaps(scene, opt, opt.causticPhotons, opt.globalPhotons, spread, 0.0f, opt.seed, progress, st);
+    PhotonIntegrator integ(scene, maps.caustic.get(), maps.global.get(), integratorSettings(scene, opt, timeDependent));
+    renderPixels(scene, integ, plan, "render", progress, film);
+    EstimateCounts c = integ.counts();
+    st.standardEstimates = c.standard;
+    st.timeEstimates = c.timeDependent;
+  }
+  finishStats(film, st);
+  st.seconds = timer.seconds();
   return film;
 }
 

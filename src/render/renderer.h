@@ -1,33 +1,58 @@
 // render/renderer.h — render(): one built scene + options -> a Film.
-// Chooses the integrator for the method once, then runs the tile loop.
+// Chooses the method once (path tracer, or photon maps + PhotonIntegrator),
+// then runs the one tile loop with adaptive (sub-pixel, time) sampling.
 #pragma once
 #include <cstdint>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include "core/progress.h"
+#include "estimate/estimators.h"
 #include "render/film.h"
 #include "scene/scene.h"
 
 namespace tdpm {
 
 struct RenderOptions {
-  std::string method = "pathtrace";
+  std::string method = "time";  // pathtrace | static | accumulation | standard | time
+  // Adaptive sampling: every pixel takes `spp` stratified samples, then
+  // further batches of `spp` while its contrast (relative standard error of
+  // the mean luminance, see renderer.cpp) exceeds `contrast`, up to maxSpp.
+  // maxSpp <= spp: exactly spp samples everywhere.
   int spp = 16;
+  int maxSpp = 0;
+  float contrast = 0.05f;
   uint64_t seed = 1;
   int maxDepth = 16;
+
+  // ---- photon methods ----
+  size_t causticPhotons = 200000;  // stored photons wanted
+  size_t globalPhotons = 50000;
+  int frames = 8;                  // accumulation: in-between frames
+  bool spaceTime4D = false;        // --search 4d
+  float kappa = 1.0f;              // 4D metric weight
+  estimate::Options estimate;      // k, ks, fraction, max radius / dt, kernels
+  float maxRadiusFraction = 0.02f; // max radius when estimate.maxRadius is not set: of the scene's diagonal
+  int gatherRays = 1;
+  bool visualizeGlobal = false;
 };
 
 struct RenderStats {
-  double seconds = 0;
+  double seconds = 0;          // everything: photon passes, trees, rendering
+  double photonSeconds = 0;    // tracing + tree builds
   uint64_t cameraSamples = 0;
+  size_t causticStored = 0, globalStored = 0;
+  uint64_t causticEmitted = 0, globalEmitted = 0;
+  double bytesPerPhoton = 0;
+  uint64_t standardEstimates = 0, timeEstimates = 0;
+  int minSpp = 0, maxSpp = 0;  // over pixels
+  std::vector<std::string> warnings;  // for the user: empty photon maps and the like
 };
 
 // Names of the methods the renderer accepts (for validation and --help).
 const char* const* renderMethods();
 bool isRenderMethod(const std::string& name);
-// Whether this build can render a method yet (photon methods come with the
-// photon-map renderer).
-bool methodAvailable(const std::string& name);
 
 Film render(const Scene& scene, const RenderOptions& options, const Progress& progress, RenderStats& stats);
 

@@ -44,7 +44,8 @@ std::vector<MotionKey> toKeys(const scene::MotionDesc& d) {
 
 Motion makeMotion(const scene::TransformDesc& placement, const scene::MotionDesc& motion, const Shutter& shutter) {
   if (motion.empty()) return Motion::still(placement.matrix());
-  return Motion::keyframed(placement.matrix(), toKeys(motion), shutter);
+  MotionKey p{0.0f, placement.translate, placement.rotate, placement.scale};
+  return Motion::keyframed(p, toKeys(motion), shutter);
 }
 
 std::vector<std::vector<Vec3f>> stepVertices(const Motion& m, const std::vector<Vec3f>& local) {

@@ -26,7 +26,9 @@ struct TransformDesc {
 // Keyframed motion: times strictly increasing, inside the shutter, two or
 // more. Between keyframes translation and scale are linear and rotation is
 // slerp; before the first / after the last the end pose holds. The motion is
-// applied on top of the static placement: world(t) = motion(t) * placement.
+// combined with the static placement P by parts (motion/motion.h):
+//   world(t) = Translate(P.t + k.t(t)) * Rotate(k.r(t) * P.r) * Scale(k.s(t) * P.s)
+// so keyframe rotations and scales act about the object's placed centre.
 struct MotionDesc {
   std::vector<float> times;
   std::vector<TransformDesc> poses;
@@ -105,13 +107,30 @@ struct CameraDesc {
   std::vector<CameraKeyframe> motion;  // empty: static; else >= 2, times increasing, inside the shutter
 };
 
-// Render settings stored in the scene; command-line flags override them.
+// Render settings stored in the scene. Each is optional: command-line flags
+// override them, and what neither gives takes the renderer's default
+// (render/renderer.h, RenderOptions), so every default lives in one place.
 struct RenderSettings {
-  std::string method = "pathtrace";  // pathtrace | static | accumulation | standard | time
-  int spp = 16;            // samples per pixel, >= 1
-  uint64_t seed = 1;
-  int maxDepth = 16;       // path vertices, >= 1
-  float exposure = 0.0f;   // PNG preview: stops
+  std::optional<std::string> method;  // pathtrace | static | accumulation | standard | time
+  std::optional<int> spp;             // first (and per-batch) samples per pixel, >= 1
+  std::optional<int> maxSpp;          // adaptive maximum, >= 1
+  std::optional<float> contrast;      // adaptive threshold, > 0
+  std::optional<uint64_t> seed;
+  std::optional<int> maxDepth;        // path vertices, >= 1
+  std::optional<float> exposure;      // PNG preview: stops
+  // photon methods
+  std::optional<int64_t> photons;         // caustic photons stored, >= 0
+  std::optional<int64_t> globalPhotons;   // global photons stored, >= 0
+  std::optional<int> frames;              // accumulation, >= 1
+  std::optional<std::string> search;      // twopass | 4d
+  std::optional<int> k;                   // photons in the spatial search, >= 1
+  std::optional<float> fraction;          // two-pass: part kept in time, (0, 1]
+  std::optional<float> kappa;             // 4D metric weight, > 0
+  std::optional<float> maxRadius;         // > 0, scene units
+  std::optional<float> maxDt;             // > 0, seconds
+  std::optional<std::string> kernelSpace; // uniform | cone | epanechnikov
+  std::optional<std::string> kernelTime;  // uniform | epanechnikov
+  std::optional<int> gather;              // final-gather rays per sample, >= 0
 };
 
 struct SceneDescription {

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include "math/frame.h"
+#include "sampling/warp.h"
+
 namespace tdpm {
 
 float Light::spotFalloff(float cosTheta) const {
@@ -102,6 +105,78 @@ bool sampleLight(const Light& light, Vec3f p, float time01, Vec2f u, LightSample
       if (out.li.isBlack()) return false;
       out.pdf = areaLightPdf(light, f, p, q);
       return out.pdf > 0;
+    }
+  }
+  return false;
+}
+
+namespace {
+
+// Bounding sphere of the scene: a directional light emits over the disc of
+// this radius facing it, from outside the sphere.
+void boundingSphere(const Bounds3f& b, Vec3f& centre, float& radius) {
+  if (b.empty()) { centre = {0, 0, 0}; radius = 1.0f; return; }
+  centre = b.center();
+  radius = std::max(1e-6f, 0.5f * length(b.diagonal()) * 1.001f);
+}
+
+}  // namespace
+
+Rgb emittedPower(const Light& light, const Bounds3f& sceneBounds) {
+  if (light.type == Light::Type::Directional) {
+    Vec3f c;
+    float r;
+    boundingSphere(sceneBounds, c, r);
+    return light.power * (kPi * r * r);
+  }
+  return light.power;
+}
+
+bool emitFromLight(const Light& light, float time01, const Bounds3f& sceneBounds, Vec2f uPos, Vec2f uDir,
+                   EmittedRay& out) {
+  switch (light.type) {
+    case Light::Type::Point: {
+      Affine3f m = light.motion.atNormalized(time01);
+      out.origin = m.point(light.position);
+      out.direction = squareToUniformSphere(uDir);
+      out.flux = light.intensity * (1.0f / kUniformSpherePdf);  // = power
+      return true;
+    }
+    case Light::Type::Spot: {
+      // Uniform over the outer cone; the falloff goes into the flux, so
+      // E[flux] = I * integral of the falloff = power.
+      Affine3f m = light.motion.atNormalized(time01);
+      Frame f(normalize(m.vector(light.direction)));
+      Vec3f local = squareToUniformCone(uDir, light.cosTotal);
+      float falloff = light.spotFalloff(local.z);
+      if (falloff <= 0) return false;
+      out.origin = m.point(light.position);
+      out.direction = f.toWorld(local);
+      out.flux = light.intensity * (falloff / uniformConePdf(light.cosTotal));
+      return true;
+    }
+    case Light::Type::Directional: {
+      Affine3f m = light.motion.atNormalized(time01);
+      Vec3f d = normalize(m.vector(light.direction));
+      Vec3f c;
+      float r;
+      boundingSphere(sceneBounds, c, r);
+      Frame f(d);
+      Vec2f disk = squareToConcentricDisk(uPos);
+      out.origin = c + (f.s * disk.x + f.t * disk.y) * r - d * r;
+      out.direction = d;
+      out.flux = light.power * (kPi * r * r);
+      return true;
+    }
+    case Light::Type::Area: {
+      AreaLightFrame fr = areaLightFrame(light, time01);
+      if (!(fr.area > 0)) return false;
+      Frame f(fr.normal);
+      out.origin = fr.center + fr.edgeX * (uPos.x - 0.5f) + fr.edgeZ * (uPos.y - 0.5f);
+      out.direction = f.toWorld(squareToCosineHemisphere(uDir));
+      // L * A * pi = power: cosine-weighted directions, uniform positions.
+      out.flux = light.power;
+      return true;
     }
   }
   return false;

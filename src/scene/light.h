@@ -54,4 +54,20 @@ bool sampleLight(const Light& light, Vec3f p, float time01, Vec2f u, LightSample
 // `hit` on an area light (for MIS when a BSDF-sampled ray hits it).
 float areaLightPdf(const Light& light, const AreaLightFrame& f, Vec3f p, Vec3f hit);
 
+// ---- photon emission ----
+
+// The ray a photon leaves a light along. flux is the light's power over the
+// density of (origin, direction) chosen, so E[flux] = emittedPower(light).
+struct EmittedRay {
+  Vec3f origin, direction;
+  Rgb flux;
+};
+
+// Power (W) a light sends into the scene. A directional light's is its
+// irradiance times the area of the disc that covers the scene's bounds.
+Rgb emittedPower(const Light& light, const Bounds3f& sceneBounds);
+// uPos, uDir: independent uniform 2D samples.
+bool emitFromLight(const Light& light, float time01, const Bounds3f& sceneBounds, Vec2f uPos, Vec2f uDir,
+                   EmittedRay& out);
+
 }  // namespace tdpm

@@ -43,6 +43,14 @@ bool Scene::intersect(Vec3f o, Vec3f d, float tFar, float time01, Hit& hit) cons
   return true;
 }
 
+bool Scene::segmentMeetsMotion(Vec3f o, Vec3f d, float tMax) const {
+  if (movingBounds.empty()) return false;
+  Vec3f inv{1.0f / d.x, 1.0f / d.y, 1.0f / d.z};
+  for (const Bounds3f& b : movingBounds)
+    if (b.intersectsSegment(o, inv, 0.0f, tMax)) return true;
+  return false;
+}
+
 bool Scene::occluded(Vec3f o, Vec3f d, float tFar, float time01) const {
   return embree_.occluded(o, d, tFar, time01);
 }

@@ -48,6 +48,9 @@ class Scene {
   // Origin for a ray leaving surface point p (normal n) in direction d:
   // pushed off the surface by a distance relative to the scene's scale.
   Vec3f spawnOrigin(Vec3f p, Vec3f n, Vec3f d) const;
+  // Whether the segment o + s d, s in [0, tMax], passes through the swept
+  // bounds of anything that moves (conservative: bounds, not surfaces).
+  bool segmentMeetsMotion(Vec3f o, Vec3f d, float tMax) const;
   float epsilon(Vec3f p) const;
 
   Camera camera;

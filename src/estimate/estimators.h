@@ -1,0 +1,300 @@
+// estimate/estimators.h — the three radiance estimates over a photon map
+// (method.md sections 3-4) behind one per-thread object, Gatherer:
+//
+//   Standard     eq. (3):  L = 1/(pi r^2 ts) sum f_r Q_p K1        (time ignored)
+//   TimeTwoPass  eq. (9):  L = 1/(pi r^2 h N) sum f_r Q_p K1 K2     (space-time cylinder)
+//   SpaceTime4D  4D k-NN, L = 1/V sum f_r Q_p, V the space-time ellipsoid
+//                clipped to the photons' time range (closed form below)
+//
+// The renderer calls Gatherer::radiance(x, n, wo, t, brdf). Choices:
+//  * BRDF: a template parameter, any functor `Rgb operator()(Vec3f wi, Vec3f
+//    wo) const` (a lambda, or a material's evaluation bound to a hit). It is
+//    inlined into the gather loop: no virtual call per photon. The method
+//    and the kernels are dispatched once per query (a switch) into loops
+//    instantiated per kernel.
+//  * Photons count only when they arrived on the side the normal faces,
+//    dot(n, wi) > 0 (wi points back towards where the photon came from), as
+//    in Jensen: thin objects do not leak light through. The search radius is
+//    still that of the k nearest of either side (the estimate stays
+//    consistent; it is the number found inside the known disc).
+//  * Radius: with k found, r = distance of the k-th; with fewer, every
+//    photon within maxRadius was found and r = maxRadius (if maxRadius is
+//    infinite, the farthest found). r^2 is at least minRadius2, so
+//    coincident photons give a large but finite value, never NaN.
+//  * Time: the 8-bit bins of photon/store.h. Two-pass: the window is the kept
+//    bins [lo, hi] (photon/temporal_select.h; ties kept whole), i.e. the
+//    interval [lo, hi + 1) in bin units, which lies inside the shutter by
+//    construction, so it is already clipped at shutter open and close.
+//    h = max(u - lo, hi + 1 - u) is the half-width of the kernel window
+//    centred on the query u, [a, b] = ([lo, hi+1] - u) / h its clipped part,
+//    N = integral of K2 over [a, b] (= b - a for uniform: the volume is
+//    pi r^2 times the window length). See docs/photon-map.md for why the
+//    window is whole bins rather than 2 max |t_p - t| with bin centres.
+#pragma once
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "estimate/kernels.h"
+#include "math/vec.h"
+#include "photon/kdtree.h"
+#include "photon/temporal_select.h"
+
+namespace tdpm::estimate {
+
+enum class Method : unsigned char { Standard, TimeTwoPass, SpaceTime4D };
+
+struct Options {
+  Method method = Method::TimeTwoPass;
+  int k = 100;              // Standard and SpaceTime4D: photons in the estimate
+  int ks = 200;             // TimeTwoPass: spatial candidates (first pass)
+  float fraction = 0.5f;    // TimeTwoPass: f, the part kept in time
+  float maxRadius = std::numeric_limits<float>::infinity();        // space (4D: of the metric)
+  float maxTimeDistance = std::numeric_limits<float>::infinity();  // seconds, TimeTwoPass
+  SpaceKernel spaceKernel = SpaceKernel::Uniform;  // Standard and TimeTwoPass
+  float coneK = 1.1f;                              // Jensen's cone filter constant
+  TimeKernel timeKernel = TimeKernel::Uniform;     // TimeTwoPass
+  float minRadius2 = 1e-12f;  // floor of r^2 (scene units^2), see header
+};
+
+// What an estimate used (tests, debugging). Filling `used` allocates, so
+// pass a Report only when you want it.
+struct Report {
+  std::vector<uint32_t> used;  // store indices of the photons summed (front side, in window)
+  int candidates = 0;          // photons found by the k-NN
+  int kept = 0;                // TimeTwoPass: inside the time window (either side)
+  float radius2 = 0.0f;        // r^2 (4D: d^2 of the metric)
+  float windowLo = 0.0f, windowHi = 0.0f;  // time window, seconds (Standard: the shutter)
+  float volume = 0.0f;         // the denominator: pi r^2 ts, pi r^2 h N, or V
+};
+
+// A BRDF that is the same for all directions (Lambertian: albedo / pi).
+struct ConstantBrdf {
+  Rgb value;
+  Rgb operator()(Vec3f /*wi*/, Vec3f /*wo*/) const { return value; }
+};
+
+// Volume of the space-time ellipsoid |dx|^2 + kappa s^2 <= d2 of a locally
+// flat surface, (u, v, s), restricted to s in [a, b] (derivation in the .cpp).
+double clippedEllipsoidVolume(double d2, double kappa, double a, double b);
+
+// One per thread: owns the k-NN scratch, so a query allocates nothing.
+class Gatherer {
+ public:
+  Gatherer(const photon::KdTree& tree, const Options& options);
+  const Options& options() const { return opt_; }
+
+  template <class Brdf>
+  Rgb radiance(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report = nullptr) {
+    switch (opt_.method) {
+      case Method::Standard: return standard(x, n, wo, brdf, report);
+      case Method::TimeTwoPass: return timeTwoPass(x, n, wo, t, brdf, report);
+      case Method::SpaceTime4D: return spaceTime4D(x, n, wo, t, brdf, report);
+    }
+    return Rgb(0.0f);
+  }
+
+  // ---- Standard, eq. (3): L = 1/(pi r^2) sum f_r(x, w_p, w) Q_p K1 / ts ----
+  template <class Brdf>
+  Rgb standard(Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, Report* report = nullptr) {
+    switch (opt_.spaceKernel) {
+      case SpaceKernel::Uniform: return standardImpl(K1Uniform{}, x, n, wo, brdf, report);
+      case SpaceKernel::Epanechnikov: return standardImpl(K1Epanechnikov{}, x, n, wo, brdf, report);
+      case SpaceKernel::Cone: return standardImpl(K1Cone(opt_.coneK), x, n, wo, brdf, report);
+    }
+    return Rgb(0.0f);
+  }
+
+  // ---- Time-dependent two-pass, eq. (9) with kernels:
+  //      L = 1/(pi r^2 h N) sum f_r Q_p K1(|x_p - x|/r) K2((t_p - t)/h) ----
+  template <class Brdf>
+  Rgb timeTwoPass(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report = nullptr) {
+    bool epa = opt_.timeKernel == TimeKernel::Epanechnikov;
+    switch (opt_.spaceKernel) {
+      case SpaceKernel::Uniform:
+        return epa ? twoPassImpl<K2Epanechnikov>(K1Uniform{}, x, n, wo, t, brdf, report)
+                   : twoPassImpl<K2Uniform>(K1Uniform{}, x, n, wo, t, brdf, report);
+      case SpaceKernel::Epanechnikov:
+        return epa ? twoPassImpl<K2Epanechnikov>(K1Epanechnikov{}, x, n, wo, t, brdf, report)
+                   : twoPassImpl<K2Uniform>(K1Epanechnikov{}, x, n, wo, t, brdf, report);
+      case SpaceKernel::Cone:
+        return epa ? twoPassImpl<K2Epanechnikov>(K1Cone(opt_.coneK), x, n, wo, t, brdf, report)
+                   : twoPassImpl<K2Uniform>(K1Cone(opt_.coneK), x, n, wo, t, brdf, report);
+    }
+    return Rgb(0.0f);
+  }
+
+  // ---- 4D: L = 1/V sum f_r Q_p over the k nearest in |dx|^2 + kappa dt^2,
+  //      V = clippedEllipsoidVolume(d^2, kappa, a, b) ----
+  template <class Brdf>
+  Rgb spaceTime4D(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report = nullptr);
+
+ private:
+  // Radius^2 of the search ball per the rule in the header comment.
+  float ballRadius2(int found, int k, float maxR2) const {
+    float r2 = found == k ? query_.radius2 : (std::isfinite(maxR2) ? maxR2 : query_.maxFound2);
+    return r2 > opt_.minRadius2 ? r2 : opt_.minRadius2;
+  }
+  template <class K1, class Brdf>
+  Rgb standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, Report* report);
+  template <class K2, class K1, class Brdf>
+  Rgb twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report);
+
+  const photon::KdTree* tree_;
+  Options opt_;
+  photon::KnnQuery query_;
+  std::vector<uint8_t> bins_;  // candidates' time bins, padded for SIMD
+  std::vector<int> kept_;      // positions of the kept candidates
+};
+
+// ---------------------------------------------------------------------------
+
+template <class K1, class Brdf>
+Rgb Gatherer::standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, Report* report) {
+  const photon::PhotonStore& s = tree_->store();
+  float maxR2 = opt_.maxRadius * opt_.maxRadius;
+  int found = tree_->knn(x, opt_.k, maxR2, query_);
+  if (report) {
+    *report = Report{};
+    report->candidates = found;
+    report->windowLo = s.t0();
+    report->windowHi = s.t1();
+  }
+  if (found == 0) return Rgb(0.0f);
+  float r2 = ballRadius2(found, opt_.k, maxR2);
+  float invR2 = 1.0f / r2;
+  const uint32_t* idx = query_.index();
+  const float* d2 = query_.dist2();
+  const uint16_t* dirs = s.directions();
+  const uint32_t* energies = s.energies();
+  Rgb sum(0.0f);
+  for (int i = 0; i < found; ++i) {
+    uint32_t p = idx[i];
+    Vec3f wi = photon::decodeDirection(dirs[p]);
+    if (!(dot(n, wi) > 0.0f)) continue;
+    sum += brdf(wi, wo) * photon::decodeRgbe(energies[p]) * k1(std::min(d2[i] * invR2, 1.0f));
+    if (report) report->used.push_back(p);
+  }
+  float volume = kPi * r2 * s.shutterLength();
+  if (report) {
+    report->radius2 = r2;
+    report->volume = volume;
+    report->kept = found;
+  }
+  return sum * (1.0f / volume);
+}
+
+template <class K2, class K1, class Brdf>
+Rgb Gatherer::twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report) {
+  const photon::PhotonStore& s = tree_->store();
+  const photon::TimeQuantiser& tq = s.time();
+  float maxR2 = opt_.maxRadius * opt_.maxRadius;
+  // ---- pass 1: k_s nearest in space ----
+  int found = tree_->knn(x, opt_.ks, maxR2, query_);
+  if (report) {
+    *report = Report{};
+    report->candidates = found;
+  }
+  if (found == 0) return Rgb(0.0f);
+  float r2 = ballRadius2(found, opt_.ks, maxR2);
+  const uint32_t* idx = query_.index();
+  const float* d2 = query_.dist2();
+  const uint16_t* flags = s.flags();
+  if (bins_.size() < size_t(found) + photon::kSelectPadding) bins_.resize(size_t(found) + photon::kSelectPadding);
+  if (kept_.size() < size_t(found)) kept_.resize(size_t(found));
+  uint8_t* bins = bins_.data();
+  for (int i = 0; i < found; ++i) bins[i] = uint8_t(flags[idx[i]] & photon::kTimeMask);
+  // ---- pass 2: the fraction f nearest in time (whole bins) ----
+  float u = tq.binUnits(t);
+  int keep = photon::keptCount(opt_.fraction, found);
+  photon::TimeWindow win =
+      photon::selectTimeWindow(bins, found, u, keep, opt_.maxTimeDistance * tq.invBinWidth);
+  if (report) report->kept = win.kept;
+  if (win.empty()) return Rgb(0.0f);
+  // ---- the cylinder: disc pi r^2 times the clipped window ----
+  float lo = float(win.lo), hi1 = float(win.hi + 1);
+  float h = std::max(u - lo, hi1 - u);  // >= 0.5: u lies in [lo, hi + 1]
+  float invH = 1.0f / h;
+  float norm = K2::integral((lo - u) * invH, (hi1 - u) * invH);
+  float volume = kPi * r2 * (h * tq.binWidth) * norm;
+  float invR2 = 1.0f / r2;
+  const uint16_t* dirs = s.directions();
+  const uint32_t* energies = s.energies();
+  // Compact the kept candidates without a branch (about half are kept, in
+  // no order a predictor could learn), then sum over them.
+  int* kept = kept_.data();
+  int m = 0;
+  const unsigned lo8 = unsigned(win.lo), width8 = unsigned(win.hi - win.lo);
+  for (int i = 0; i < found; ++i) {
+    kept[m] = i;
+    m += int(unsigned(bins[i]) - lo8 <= width8);
+  }
+  Rgb sum(0.0f);
+  for (int j = 0; j < m; ++j) {
+    int i = kept[j];
+    uint32_t p = idx[i];
+    Vec3f wi = photon::decodeDirection(dirs[p]);
+    if (!(dot(n, wi) > 0.0f)) continue;
+    float y0 = (float(bins[i]) - u) * invH;
+    float w = k1(std::min(d2[i] * invR2, 1.0f)) * K2::binMean(y0, y0 + invH);
+    sum += brdf(wi, wo) * photon::decodeRgbe(energies[p]) * w;
+    if (report) report->used.push_back(p);
+  }
+  if (report) {
+    report->radius2 = r2;
+    report->volume = volume;
+    report->windowLo = tq.binStart(win.lo);
+    report->windowHi = tq.binStart(win.hi + 1);
+  }
+  return sum * (1.0f / volume);
+}
+
+template <class Brdf>
+Rgb Gatherer::spaceTime4D(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report) {
+  const photon::PhotonStore& s = tree_->store();
+  const photon::TimeQuantiser& tq = s.time();
+  t = std::min(std::max(t, tq.t0), tq.t1);
+  float maxD2 = opt_.maxRadius * opt_.maxRadius;
+  int found = tree_->knn4(x, t, opt_.k, maxD2, query_);
+  if (report) {
+    *report = Report{};
+    report->candidates = found;
+    report->kept = found;
+  }
+  if (found == 0) return Rgb(0.0f);
+  float D2 = ballRadius2(found, opt_.k, maxD2);
+  const uint32_t* idx = query_.index();
+  const uint16_t* flags = s.flags();
+  const uint16_t* dirs = s.directions();
+  const uint32_t* energies = s.energies();
+  int qmin = 255, qmax = 0;
+  Rgb sum(0.0f);
+  for (int i = 0; i < found; ++i) {
+    uint32_t p = idx[i];
+    int q = flags[p] & photon::kTimeMask;
+    qmin = std::min(qmin, q);
+    qmax = std::max(qmax, q);
+    Vec3f wi = photon::decodeDirection(dirs[p]);
+    if (!(dot(n, wi) > 0.0f)) continue;
+    sum += brdf(wi, wo) * photon::decodeRgbe(energies[p]);
+    if (report) report->used.push_back(p);
+  }
+  // Time extent of the ellipsoid, clipped to the photons' bins (whose union
+  // lies inside the shutter): s in [a, b] relative to t.
+  double kappa = tree_->kappa();
+  double half = std::sqrt(double(D2) / kappa);
+  double a = std::max(-half, double(tq.binStart(qmin)) - t);
+  double b = std::min(half, double(tq.binStart(qmax + 1)) - t);
+  double volume = clippedEllipsoidVolume(D2, kappa, a, b);
+  if (report) {
+    report->radius2 = D2;
+    report->volume = float(volume);
+    report->windowLo = float(t + a);
+    report->windowHi = float(t + b);
+  }
+  if (!(volume > 0.0)) return Rgb(0.0f);
+  return sum * float(1.0 / volume);
+}
+
+}  // namespace tdpm::estimate

@@ -1,0 +1,341 @@
+// photon/kdtree.cpp — parallel build of the left-balanced kd-tree and the
+// k-nearest-neighbour search (3D and 4D share one template).
+#include "photon/kdtree.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "core/error.h"
+
+namespace tdpm::photon {
+
+KnnQuery::KnnQuery(int capacity) { reserve(capacity); }
+
+void KnnQuery::reserve(int capacity) {
+  if (capacity <= capacity_) return;
+  capacity_ = capacity;
+  index_.resize(size_t(capacity) + 4);  // + the heap's sentinel slots
+  dist2_.resize(size_t(capacity) + 4);
+  stack_.resize(128);  // > tree height for any size_t photon count
+}
+
+// ---- build ----
+
+namespace {
+
+// Number of nodes in the left subtree of a left-balanced (complete, filled
+// left to right) binary tree of n >= 2 nodes: the levels above the last are
+// full; the last level fills the left subtree first.
+size_t leftSubtreeSize(size_t n) {
+  int h = 63 - __builtin_clzll(uint64_t(n));  // floor(log2 n) >= 1
+  size_t half = size_t(1) << (h - 1);         // last-level capacity of the left subtree
+  size_t full = (size_t(1) << h) - 1;         // nodes in the full levels
+  size_t last = n - full;
+  return half - 1 + std::min(last, half);
+}
+
+// The builder works on a compact copy of the keys (16 or 20 bytes per
+// photon, freed after the build): nth_element on contiguous records is much
+// faster than on indices into the store's separate arrays.
+template <int D>
+struct Item {
+  float k[D];
+  uint32_t idx;
+};
+
+template <int D>
+struct Box {
+  float lo[D], hi[D];
+  Box() {
+    for (int a = 0; a < D; ++a) {
+      lo[a] = std::numeric_limits<float>::infinity();
+      hi[a] = -std::numeric_limits<float>::infinity();
+    }
+  }
+  Box& extend(const Item<D>* it, size_t n) {
+    for (size_t i = 0; i < n; ++i)
+      for (int a = 0; a < D; ++a) {
+        lo[a] = std::min(lo[a], it[i].k[a]);
+        hi[a] = std::max(hi[a], it[i].k[a]);
+      }
+    return *this;
+  }
+  Box& merge(const Box& b) {
+    for (int a = 0; a < D; ++a) {
+      lo[a] = std::min(lo[a], b.lo[a]);
+      hi[a] = std::max(hi[a], b.hi[a]);
+    }
+    return *this;
+  }
+};
+
+template <int D>
+struct Builder {
+  Item<D>* items;
+  uint32_t* order;  // order[heap node] = original photon index
+  uint8_t* axes;    // split axis per heap node
+  size_t cutoff;
+
+  // Subtree rooted at heap node `node` holds it[0, n). The split axis is
+  // the widest extent of the photons' actual bounds: Jensen's cell bounds
+  // cut at each split are cheaper, but on surfaces (a floor at y = 0 under a
+  // wall) they keep a phantom extent in y and split on it, which for equal
+  // keys is an arbitrary partition: overlapping cells that every query must
+  // enter on both sides. The scan costs less than the nth_element after it.
+  void build(Item<D>* it, size_t n, size_t node) const {
+    if (n == 0) return;
+    if (n == 1) {
+      order[node] = it[0].idx;
+      axes[node] = 0;
+      return;
+    }
+    Box<D> box = n >= cutoff ? tbb::parallel_reduce(
+                                   tbb::blocked_range<size_t>(0, n, 1 << 14), Box<D>{},
+                                   [it](const tbb::blocked_range<size_t>& r, Box<D> b) {
+                                     return b.extend(it + r.begin(), r.size());
+                                   },
+                                   [](Box<D> a, const Box<D>& b) { return a.merge(b); })
+                             : Box<D>{}.extend(it, n);
+    const float *lo = box.lo, *hi = box.hi;
+    int axis = 0;
+    float ext = hi[0] - lo[0];
+    for (int a = 1; a < D; ++a)
+      if (hi[a] - lo[a] > ext) { ext = hi[a] - lo[a]; axis = a; }
+    size_t m = leftSubtreeSize(n);
+    std::nth_element(it, it + m, it + n, [axis](const Item<D>& a, const Item<D>& b) { return a.k[axis] < b.k[axis]; });
+    order[node] = it[m].idx;
+    axes[node] = uint8_t(axis);
+    auto left = [&] { build(it, m, 2 * node + 1); };
+    auto right = [&] { build(it + m + 1, n - m - 1, 2 * node + 2); };
+    if (n >= cutoff) {
+      tbb::parallel_invoke(left, right);
+    } else {
+      left();
+      right();
+    }
+  }
+};
+
+template <int D>
+void buildTree(const PhotonStore& store, const float* timeKey, size_t cutoff, std::vector<uint32_t>& order,
+               std::vector<uint8_t>& axes) {
+  size_t n = store.size();
+  std::vector<Item<D>> items(n);
+  const float *X = store.xs(), *Y = store.ys(), *Z = store.zs();
+  const uint16_t* F = store.flags();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      Item<D>& t = items[i];
+      t.k[0] = X[i];
+      t.k[1] = Y[i];
+      t.k[2] = Z[i];
+      if constexpr (D == 4) t.k[3] = timeKey[F[i] & kTimeMask];
+      t.idx = uint32_t(i);
+    }
+  });
+  order.resize(n);
+  axes.resize(n);
+  Builder<D> b{items.data(), order.data(), axes.data(), std::max<size_t>(cutoff, 2)};
+  b.build(items.data(), n, 0);
+}
+
+}  // namespace
+
+KdTree KdTree::build(PhotonStore& store, const KdBuildOptions& options) {
+  TDPM_ASSERT(store.size() < (size_t(1) << 32), "kd-tree indices are 32-bit");
+  TDPM_ASSERT(!options.spaceTime || options.kappa > 0.0f, "4D kd-tree needs kappa > 0");
+  KdTree tree;
+  tree.store_ = &store;
+  tree.n_ = store.size();
+  tree.spaceTime_ = options.spaceTime;
+  tree.kappa_ = options.kappa;
+  float sk = std::sqrt(options.kappa);
+  tree.timeBase_ = sk * store.time().binCentre(0);
+  tree.timeStep_ = sk * store.time().binWidth;
+  float timeKey[kTimeBins];
+  for (int q = 0; q < kTimeBins; ++q) timeKey[q] = tree.timeBase_ + float(q) * tree.timeStep_;
+
+  std::vector<uint32_t> localOrder;
+  std::vector<uint32_t>& order = options.order ? *options.order : localOrder;
+  std::vector<uint8_t> axes;
+  if (options.spaceTime)
+    buildTree<4>(store, timeKey, options.parallelCutoff, order, axes);
+  else
+    buildTree<3>(store, timeKey, options.parallelCutoff, order, axes);
+  store.permute(order.data());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, tree.n_, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) store.setSplitAxis(i, axes[i]);
+  });
+  return tree;
+}
+
+double KdTree::bytesPerPhoton() const {
+  if (n_ == 0) return 0.0;
+  return store_->bytesPerPhoton();
+}
+
+// ---- k-nearest-neighbour search ----
+
+namespace {
+
+// Max-heap on dist2 (root = the farthest candidate), index carried along.
+// The choice between the two children is branch-free: it is a coin flip for
+// the branch predictor, and sifting is a large part of the k-NN's time.
+// (A 4-ary heap measured slower here.) d2[n] must hold -infinity (a
+// sentinel right child for the last left child, never chosen).
+inline void siftDown(float* d2, uint32_t* idx, int n, int i) {
+  float d = d2[i];
+  uint32_t v = idx[i];
+  for (;;) {
+    int c = 2 * i + 1;
+    if (c >= n) break;
+    c += int(d2[c + 1] > d2[c]);
+    float dc = d2[c];
+    if (dc <= d) break;
+    d2[i] = dc;
+    idx[i] = idx[c];
+    i = c;
+  }
+  d2[i] = d;
+  idx[i] = v;
+}
+constexpr int kHeapPad = 1;
+
+}  // namespace
+
+template <int D>
+int KdTree::knnImpl(const float* key, int k, float maxRadius2, KnnQuery& q) const {
+  q.count = 0;
+  q.radius2 = maxRadius2;
+  q.maxFound2 = 0.0f;
+  if (n_ == 0 || k <= 0 || !(maxRadius2 > 0.0f)) return 0;
+  q.reserve(k);
+  const float *X = store_->xs(), *Y = store_->ys(), *Z = store_->zs();
+  const uint16_t* F = store_->flags();
+  uint32_t* idx = q.index_.data();
+  float* d2 = q.dist2_.data();
+  KnnQuery::StackEntry* stack = q.stack_.data();
+  const uint32_t n = uint32_t(n_);
+  const float kx = key[0], ky = key[1], kz = key[2];
+  const float kt = D == 4 ? key[3] : 0.0f;
+
+  float r2 = maxRadius2;
+  int count = 0, sp = 0;
+  // Offsets of the query from the current cell per axis (0 inside its slab);
+  // cellDist2 = sum of their squares bounds every photon of the subtree.
+  float off[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  float cellDist2 = 0.0f;
+
+  auto test = [&](uint32_t p) {
+    float dx = X[p] - kx, dy = Y[p] - ky, dz = Z[p] - kz;
+    float dist = dx * dx + dy * dy + dz * dz;
+    if constexpr (D == 4) {
+      float dt = timeBase_ + float(F[p] & kTimeMask) * timeStep_ - kt;
+      dist += dt * dt;
+    }
+    if (dist < r2) {
+      if (count < k) {
+        idx[count] = p;
+        d2[count] = dist;
+        if (++count == k) {
+          for (int i = 0; i < kHeapPad; ++i) d2[k + i] = -std::numeric_limits<float>::infinity();
+          for (int i = k / 2 - 1; i >= 0; --i) siftDown(d2, idx, k, i);
+          r2 = d2[0];
+        }
+      } else {
+        d2[0] = dist;
+        idx[0] = p;
+        siftDown(d2, idx, k, 0);
+        r2 = d2[0];
+      }
+    }
+  };
+
+  uint32_t node = 0;
+  for (;;) {
+    // ---- descend to a leaf along the query's side, deferring each node
+    //      (tested later, like Jensen's recursion) and its far side ----
+    for (;;) {
+      uint32_t left = 2 * node + 1;
+      if (left >= n) {
+        test(node);
+        break;
+      }
+      // The subtree four levels down is 16 consecutive nodes: fetch them
+      // early, the descent is otherwise a chain of dependent cache misses.
+      uint32_t ahead = 16 * node + 15;
+      if (ahead < n) {
+        __builtin_prefetch(X + ahead);
+        __builtin_prefetch(Y + ahead);
+        __builtin_prefetch(Z + ahead);
+        __builtin_prefetch(F + ahead);
+      }
+      int axis = (F[node] & kAxisMask) >> kAxisShift;
+      float split;
+      if constexpr (D == 4)
+        split = axis == 0 ? X[node] : axis == 1 ? Y[node] : axis == 2 ? Z[node]
+                                                          : timeBase_ + float(F[node] & kTimeMask) * timeStep_;
+      else
+        split = axis == 0 ? X[node] : axis == 1 ? Y[node] : Z[node];
+      // delta > 0: the query is on the left (<= split) side.
+      float delta = split - key[axis];
+      uint32_t nearC = delta > 0.0f ? left : left + 1;
+      uint32_t farC = delta > 0.0f ? left + 1 : left;
+      // The far cell (and the node, on the plane) lie beyond the plane: the
+      // offset on this axis becomes |delta|, never less than the current one.
+      float farDist2 = cellDist2 - off[axis] * off[axis] + delta * delta;
+      if (farDist2 < r2) {
+        KnnQuery::StackEntry& e = stack[sp++];
+        e.node = node;
+        e.far = farC < n ? farC : 0;
+        e.cellDist2 = farDist2;
+        for (int a = 0; a < D; ++a) e.offset[a] = off[a];
+        e.offset[axis] = delta;
+      }
+      if (nearC >= n) break;
+      node = nearC;
+    }
+    // ---- pop the next deferred node still within the current radius ----
+    bool found = false;
+    while (sp > 0) {
+      const KnnQuery::StackEntry& e = stack[--sp];
+      if (e.cellDist2 < r2) {
+        test(e.node);
+        if (e.far == 0 || !(e.cellDist2 < r2)) continue;
+        node = e.far;
+        cellDist2 = e.cellDist2;
+        for (int a = 0; a < D; ++a) off[a] = e.offset[a];
+        found = true;
+        break;
+      }
+    }
+    if (!found) break;
+  }
+
+  q.count = count;
+  float mx = 0.0f;
+  for (int i = 0; i < count; ++i) mx = std::max(mx, d2[i]);
+  q.maxFound2 = mx;
+  q.radius2 = count == k ? r2 : maxRadius2;
+  return count;
+}
+
+int KdTree::knn(Vec3f p, int k, float maxRadius2, KnnQuery& q) const {
+  TDPM_ASSERT(!spaceTime_, "knn() needs the 3D tree; this one is space-time (use knn4)");
+  float key[3] = {p.x, p.y, p.z};
+  return knnImpl<3>(key, k, maxRadius2, q);
+}
+
+int KdTree::knn4(Vec3f p, float t, int k, float maxDist2, KnnQuery& q) const {
+  TDPM_ASSERT(spaceTime_, "knn4() needs the space-time tree (KdBuildOptions::spaceTime)");
+  float key[4] = {p.x, p.y, p.z, std::sqrt(kappa_) * t};
+  return knnImpl<4>(key, k, maxDist2, q);
+}
+
+}  // namespace tdpm::photon

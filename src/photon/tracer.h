@@ -1,0 +1,52 @@
+// photon/tracer.h — emission and tracing of photon paths in time.
+// Each path draws one time (a scrambled van der Corput sequence over the
+// shutter, or a fixed time for the static and accumulation methods) and is
+// traced through the scene as it is at that time; every stored photon keeps
+// it. Photons carry radiant energy Q = flux * ts / n_emitted (method.md
+// section 2). Two maps, traced separately so each gets its own budget:
+//  * caustic: paths L S+ D, stored at the first non-delta surface;
+//  * global: every non-delta surface hit.
+// Work is split into fixed batches with their own seeds and concatenated in
+// batch order, so the maps are identical for any thread count.
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "core/progress.h"
+#include "photon/store.h"
+#include "scene/scene.h"
+
+namespace tdpm::photon {
+
+enum class MapKind : uint8_t { Caustic, Global };
+
+struct TraceSettings {
+  MapKind kind = MapKind::Caustic;
+  size_t storedWanted = 100000;  // photons to store (the emitted count is chosen to reach it)
+  uint64_t seed = 1;
+  int maxBounces = 16;
+  bool spreadInTime = true;      // false: every path at fixedTime01
+  float fixedTime01 = 0.0f;
+};
+
+struct TraceResult {
+  PhotonStore store;
+  uint64_t emitted = 0;  // n_e: paths emitted from all lights
+  double seconds = 0;
+  std::string warning;   // set when the map is empty or smaller than wanted
+};
+
+// Shutter interval the photon store quantises time over. A zero-length
+// shutter uses a nominal 1-second range (energies and estimates use the
+// same length, so it cancels).
+void photonTimeRange(const Scene& scene, float& t0, float& t1);
+
+// Traces one map. An empty result (no lights, or no specular surface for a
+// caustic map) is valid; a scene that stores almost nothing stops after a
+// bounded number of paths instead of hanging.
+TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, const Progress& progress);
+
+// Whether any path could contribute to a caustic map (a delta-only surface).
+bool sceneHasSpecular(const Scene& scene);
+
+}  // namespace tdpm::photon

@@ -1,0 +1,34 @@
+// render/direct_light.cpp — shadow rays toward every light.
+#include "render/direct_light.h"
+
+#include <cmath>
+
+#include "sampling/warp.h"
+
+namespace tdpm {
+
+Rgb directLight(const Scene& scene, const Hit& hit, const ShadingContext& ctx, float time01, Rng& rng,
+                bool misWithBsdf) {
+  Rgb sum(0.0f);
+  for (const Light& light : scene.lights) {
+    LightSample ls;
+    Vec2f u{rng.uniform(), rng.uniform()};
+    if (!sampleLight(light, hit.p, time01, u, ls)) continue;
+    Rgb f = bsdfEval(ctx, ls.wi);
+    if (f.isBlack()) continue;
+    float cosTheta = std::fabs(dot(ls.wi, ctx.frame.n));
+    Vec3f o = scene.spawnOrigin(hit.p, hit.n, ls.wi);
+    // Stop short of the light's own surface (area lights are geometry).
+    float tMax = std::isinf(ls.distance) ? ls.distance : ls.distance * (1.0f - 1e-4f) - scene.epsilon(hit.p);
+    if (tMax <= 0 || scene.occluded(o, ls.wi, tMax, time01)) continue;
+    if (light.isDelta()) {
+      sum += f * ls.li * cosTheta;
+    } else {
+      float w = misWithBsdf ? powerHeuristic(ls.pdf, bsdfPdf(ctx, ls.wi)) : 1.0f;
+      sum += f * ls.li * (cosTheta * w / ls.pdf);
+    }
+  }
+  return sum;
+}
+
+}  // namespace tdpm

@@ -1,0 +1,139 @@
+// render/photon_integrator.cpp — gather points, estimates, final gather.
+#include "render/photon_integrator.h"
+
+#include <cmath>
+#include <limits>
+
+#include "render/direct_light.h"
+#include "scene/bsdf.h"
+
+namespace tdpm {
+
+namespace {
+constexpr int kGatherSpecularBounces = 4;  // a gather ray may pass this many mirrors/glass
+constexpr float kInf = std::numeric_limits<float>::infinity();
+}  // namespace
+
+PhotonIntegrator::PhotonIntegrator(const Scene& scene, const PhotonMap* caustic, const PhotonMap* global,
+                                   const PhotonIntegratorSettings& settings)
+    : scene_(scene), caustic_(caustic), global_(global), s_(settings) {}
+
+void PhotonIntegrator::flush(ThreadState& ts) const {
+  standardCount_ += ts.counts.standard;
+  timeCount_ += ts.counts.timeDependent;
+  ts.counts = {};
+}
+
+EstimateCounts PhotonIntegrator::counts() const { return {standardCount_.load(), timeCount_.load()}; }
+
+Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::Gatherer>& g,
+                               std::unique_ptr<estimate::Gatherer>& g3, const Hit& hit, const ShadingContext& ctx,
+                               Vec3f wo, float time01, bool timeDependent, EstimateCounts& counts) const {
+  if (!map || map->size() == 0) return Rgb(0.0f);
+  auto brdf = [&ctx](Vec3f wi, Vec3f) { return bsdfEval(ctx, wi); };
+  Vec3f n = ctx.frame.n;  // faces the viewer: photons from the other side do not count
+  if (timeDependent) {
+    ++counts.timeDependent;
+    if (!g) {
+      estimate::Options o = s_.estimate;
+      o.method = s_.spaceTime4D ? estimate::Method::SpaceTime4D : estimate::Method::TimeTwoPass;
+      g = std::make_unique<estimate::Gatherer>(map->tree, o);
+    }
+    float t = scene_.shutter.instant() ? map->store.t0() : scene_.shutter.fromNormalized(time01);
+    return g->radiance(hit.p, n, wo, t, brdf);
+  }
+  ++counts.standard;
+  if (!g3) {
+    estimate::Options o = s_.estimate;
+    o.method = estimate::Method::Standard;
+    g3 = std::make_unique<estimate::Gatherer>(map->spatialTree(), o);
+  }
+  return g3->standard(hit.p, n, wo, brdf);
+}
+
+Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, float time01, bool touched, Rng& rng,
+                                  ThreadState& ts) const {
+  Rgb sum(0.0f);
+  for (int i = 0; i < s_.gatherRays; ++i) {
+    BsdfSample bs;
+    Vec2f u{rng.uniform(), rng.uniform()};
+    if (!bsdfSample(ctx, u, rng.uniform(), Transport::Radiance, bs)) continue;
+    Rgb beta = bs.weight;
+    Vec3f o = scene_.spawnOrigin(hit.p, hit.n, bs.wi), d = bs.wi;
+    bool moved = touched;
+    for (int bounce = 0; bounce <= kGatherSpecularBounces; ++bounce) {
+      Hit h;
+      if (!scene_.intersect(o, d, kInf, time01, h)) {
+        sum += beta * scene_.background;
+        break;
+      }
+      moved = moved || scene_.segmentMeetsMotion(o, d, h.t);
+      if (h.isLight()) break;  // direct light was counted by the shadow rays
+      const Material& m = scene_.materials[scene_.objects[h.object].material];
+      ShadingContext c = makeShadingContext(m, m.albedo.at(h.localP), h.n, -d);
+      if (!m.isDeltaOnly()) {
+        sum += beta * estimate(global_, ts.global, ts.global3, h, c, -d, time01, s_.timeDependent && moved, ts.counts);
+        break;
+      }
+      BsdfSample sb;
+      Vec2f u2{rng.uniform(), rng.uniform()};
+      if (!bsdfSample(c, u2, rng.uniform(), Transport::Radiance, sb)) break;
+      beta *= sb.weight;
+      o = scene_.spawnOrigin(h.p, h.n, sb.wi);
+      d = sb.wi;
+    }
+  }
+  return sum / float(s_.gatherRays);
+}
+
+Rgb PhotonIntegrator::radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng, ThreadState& ts) const {
+  Rgb L(0.0f), beta(1.0f);
+  // A moving camera sees a different surface point at each time: never
+  // the fixed-point time average, so always the time-dependent estimate.
+  bool touched = scene_.camera.moving();
+  bool lastDelta = true;
+  for (int depth = 0; depth < s_.maxDepth; ++depth) {
+    Hit hit;
+    if (!scene_.intersect(origin, dir, kInf, time01, hit)) {
+      L += beta * scene_.background;
+      break;
+    }
+    touched = touched || scene_.segmentMeetsMotion(origin, dir, hit.t);
+    if (hit.isLight()) {
+      // Seen directly or through mirrors/glass only: shadow rays cannot.
+      if (lastDelta) {
+        const Light& light = scene_.lights[size_t(hit.light)];
+        L += beta * areaLightRadiance(light, areaLightFrame(light, time01), -dir);
+      }
+      break;
+    }
+    const Material& mat = scene_.materials[scene_.objects[hit.object].material];
+    ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
+    bool timeDependent = s_.timeDependent && touched;
+
+    if (!mat.isDeltaOnly()) {
+      // ---- gather point ----
+      if (s_.visualizeGlobal) {
+        L += beta * estimate(global_, ts.global, ts.global3, hit, ctx, -dir, time01, timeDependent, ts.counts);
+        break;
+      }
+      L += beta * directLight(scene_, hit, ctx, time01, rng, /*misWithBsdf=*/false);
+      L += beta * estimate(caustic_, ts.caustic, ts.caustic3, hit, ctx, -dir, time01, timeDependent, ts.counts);
+      if (global_ && global_->size() > 0) L += beta * finalGather(hit, ctx, time01, touched, rng, ts);
+      break;
+    }
+
+    // ---- mirror / glass: follow one branch ----
+    BsdfSample bs;
+    Vec2f u{rng.uniform(), rng.uniform()};
+    if (!bsdfSample(ctx, u, rng.uniform(), Transport::Radiance, bs)) break;
+    beta *= bs.weight;
+    if (beta.isBlack() || !isFinite(beta)) break;
+    lastDelta = true;
+    origin = scene_.spawnOrigin(hit.p, hit.n, bs.wi);
+    dir = bs.wi;
+  }
+  return L;
+}
+
+}  // namespace tdpm

@@ -1,0 +1,66 @@
+// render/photon_integrator.h — eye paths for the four photon-map methods.
+// An eye path at time t follows mirrors and glass (one branch chosen by
+// Fresnel) to the first non-delta surface, the gather point, and there adds
+//   direct light (shadow rays at t) + caustics (caustic map) +
+//   indirect light (final gather: BSDF-sampled rays whose first non-delta
+//   hit is estimated from the global map).
+// Which estimate (method.md section 3, "when to use which"): with
+// `timeDependent`, a gather point whose eye path (or gather ray) passed
+// through the swept bounds of anything moving, or whose camera moves, uses
+// the time-dependent estimate; any other uses the standard one, which is
+// exactly the time average the pixel wants there. Counts of both are kept.
+#pragma once
+#include <cstdint>
+#include <atomic>
+#include <memory>
+
+#include "core/rng.h"
+#include "estimate/estimators.h"
+#include "render/photon_map.h"
+#include "scene/scene.h"
+
+namespace tdpm {
+
+struct PhotonIntegratorSettings {
+  bool timeDependent = true;      // method `time`; false: standard everywhere
+  bool spaceTime4D = false;       // --search 4d
+  estimate::Options estimate;     // k, ks, fraction, radii, kernels (method set per query)
+  int gatherRays = 1;             // final-gather rays per eye sample
+  bool visualizeGlobal = false;   // gather point = global-map estimate alone (no direct, no gather)
+  int maxDepth = 16;
+};
+
+struct EstimateCounts {
+  uint64_t standard = 0, timeDependent = 0;
+};
+
+class PhotonIntegrator {
+ public:
+  struct ThreadState {
+    std::unique_ptr<estimate::Gatherer> caustic, caustic3, global, global3;
+    EstimateCounts counts;
+  };
+
+  PhotonIntegrator(const Scene& scene, const PhotonMap* caustic, const PhotonMap* global,
+                   const PhotonIntegratorSettings& settings);
+
+  Rgb radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng, ThreadState& ts) const;
+  // Moves a thread's counters into the totals (called once per tile).
+  void flush(ThreadState& ts) const;
+  EstimateCounts counts() const;
+
+ private:
+  Rgb estimate(const PhotonMap* map, std::unique_ptr<estimate::Gatherer>& g, std::unique_ptr<estimate::Gatherer>& g3,
+               const Hit& hit, const struct ShadingContext& ctx, Vec3f wo, float time01, bool timeDependent,
+               EstimateCounts& counts) const;
+  Rgb finalGather(const Hit& hit, const struct ShadingContext& ctx, float time01, bool touched, Rng& rng,
+                  ThreadState& ts) const;
+
+  const Scene& scene_;
+  const PhotonMap* caustic_;
+  const PhotonMap* global_;
+  PhotonIntegratorSettings s_;
+  mutable std::atomic<uint64_t> standardCount_{0}, timeCount_{0};
+};
+
+}  // namespace tdpm

@@ -1,0 +1,645 @@
+// scene/parse.cpp — owns turning a scene file (JSON) into a validated
+// SceneDescription: the meaning of every key, its defaults and its valid
+// range (docs/scene-format.md is the user-facing version of this file).
+// Typed reading and the error format live in parse_node.*, positions in
+// json_locate.*, OBJ loading in mesh_obj.*.
+#include "scene/parse.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <climits>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+#include "scene/json_locate.h"
+#include "scene/mesh_obj.h"
+#include "scene/parse_node.h"
+
+namespace tdpm::scene {
+
+namespace {
+
+using detail::formatNumber;
+using detail::formatRgb;
+using detail::formatVec;
+using detail::Json;
+using detail::joinNames;
+using detail::Node;
+using detail::Source;
+
+constexpr int64_t kMaxResolution = 65536;
+constexpr float kDegrees = kPi / 180.0f;
+
+struct Shutter {
+  float open = 0, close = 1;
+};
+
+std::string fmt(double v) { return formatNumber(v); }
+
+// The member if present, else the object: where to point an error about a
+// value that may have come from a default.
+Node memberOr(const Node& object, const char* key) { return object.has(key) ? object.member(key) : object; }
+
+bool isZero(Vec3f v) { return v.x == 0 && v.y == 0 && v.z == 0; }
+
+// Normalises without underflow for tiny but non-zero vectors.
+Vec3f safeNormalize(Vec3f v) {
+  float m = std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)});
+  return normalize(v / m);
+}
+
+Vec3f readDirection(const Node& n) {
+  Vec3f d = n.vec3();
+  n.require(!isZero(d), "direction must not be a zero vector");
+  return safeNormalize(d);
+}
+
+float readPositive(const Node& n, const char* what) {
+  float v = n.number();
+  n.require(v > 0, std::string(what) + " must be positive, got " + fmt(v));
+  return v;
+}
+
+// A colour that a surface reflects or transmits: at most 1 per channel, or
+// the material would create energy.
+Rgb readReflectance(const Node& n) {
+  Rgb c = n.color();
+  n.require(c.maxComponent() <= 1.0f,
+            "reflectance must be at most 1 in every channel (energy conservation), got " + formatRgb(c));
+  return c;
+}
+
+// ---------------------------------------------------------------- transforms
+
+Quaternion readRotation(const Node& n) {
+  n.expectObject({"axis", "angle"});
+  Node axisNode = n.required("axis");
+  Vec3f axis = axisNode.vec3();
+  axisNode.require(!isZero(axis), "rotation axis must not be a zero vector");
+  float angle = n.required("angle").number();
+  return Quaternion::fromAxisAngle(safeNormalize(axis), angle * kDegrees);
+}
+
+Vec3f readScale(const Node& n) {
+  Vec3f s = n.numberOrVec3();
+  n.require(s.x != 0 && s.y != 0 && s.z != 0, "scale must not have a zero component, got " + formatVec(s));
+  return s;
+}
+
+void readPoseFields(const Node& n, TransformDesc* t) {
+  if (n.has("translate")) t->translate = n.member("translate").vec3();
+  if (n.has("rotate")) t->rotate = readRotation(n.member("rotate"));
+  if (n.has("scale")) t->scale = readScale(n.member("scale"));
+}
+
+TransformDesc readTransform(const Node& n) {
+  n.expectObject({"translate", "rotate", "scale"});
+  TransformDesc t;
+  readPoseFields(n, &t);
+  return t;
+}
+
+// ---------------------------------------------------------------- motion
+
+size_t keyframeCount(const Node& motion) {
+  size_t n = motion.arraySize("keyframes");
+  motion.require(n >= 2, "motion needs at least 2 keyframes, got " + std::to_string(n));
+  return n;
+}
+
+// Keyframe `index`'s time: strictly after `previous`, inside the shutter.
+float readKeyTime(const Node& key, size_t index, float previous, Shutter s) {
+  Node t = key.required("time");
+  float time = t.number();
+  t.require(index == 0 || time > previous,
+            "keyframe times must be strictly increasing: " + fmt(time) + " does not come after " + fmt(previous));
+  t.require(time >= s.open && time <= s.close,
+            "time " + fmt(time) + " is outside the shutter [" + fmt(s.open) + ", " + fmt(s.close) + "]");
+  return time;
+}
+
+MotionDesc readMotion(const Node& n, Shutter s) {
+  MotionDesc m;
+  size_t count = keyframeCount(n);
+  for (size_t i = 0; i < count; ++i) {
+    Node key = n.element(i);
+    key.expectObject({"time", "translate", "rotate", "scale"});
+    m.times.push_back(readKeyTime(key, i, i ? m.times.back() : 0.0f, s));
+    TransformDesc pose;  // identity unless given
+    readPoseFields(key, &pose);
+    m.poses.push_back(pose);
+  }
+  return m;
+}
+
+// ---------------------------------------------------------------- camera
+
+// A look-at frame must be well defined: distinct eye and target, up not
+// along the view direction.
+void checkView(const Node& at, Vec3f position, Vec3f target, Vec3f up) {
+  memberOr(at, "target").require(!(position.x == target.x && position.y == target.y && position.z == target.z),
+                                 "camera position and target are the same point " + formatVec(position));
+  Node upNode = memberOr(at, "up");
+  upNode.require(!isZero(up), "up must not be a zero vector");
+  Vec3f dir = safeNormalize(target - position);
+  upNode.require(length(cross(dir, safeNormalize(up))) > 1e-4f,
+                 "up " + formatVec(up) + " is parallel to the view direction " + formatVec(dir));
+}
+
+void readResolution(const Node& n, CameraDesc* cam) {
+  size_t size = n.arraySize("2 integers [width, height]");
+  n.require(size == 2, "expected an array of 2 integers [width, height], got " + detail::describeKind(n.json()));
+  int64_t w = n.element(0).integer(), h = n.element(1).integer();
+  std::string res = std::to_string(w) + "x" + std::to_string(h);
+  n.require(w >= 1 && h >= 1, "resolution must be at least 1x1, got " + res);
+  n.require(w <= kMaxResolution && h <= kMaxResolution,
+            "resolution " + res + " is too large (at most " + std::to_string(kMaxResolution) + " per side)");
+  cam->width = int(w);
+  cam->height = int(h);
+}
+
+void readShutter(const Node& n, CameraDesc* cam) {
+  Vec2f s = n.vec2();
+  n.require(s.y >= s.x, "shutter close (" + fmt(s.y) + ") is before open (" + fmt(s.x) + ")");
+  cam->shutterOpen = s.x;
+  cam->shutterClose = s.y;
+}
+
+// Camera keyframes default to the camera's own position, target and up.
+std::vector<CameraKeyframe> readCameraMotion(const Node& n, const CameraDesc& cam) {
+  std::vector<CameraKeyframe> keys;
+  size_t count = keyframeCount(n);
+  Shutter s{cam.shutterOpen, cam.shutterClose};
+  for (size_t i = 0; i < count; ++i) {
+    Node key = n.element(i);
+    key.expectObject({"time", "position", "target", "up"});
+    CameraKeyframe k{0, cam.position, cam.target, cam.up};
+    k.time = readKeyTime(key, i, i ? keys.back().time : 0.0f, s);
+    if (key.has("position")) k.position = key.member("position").vec3();
+    if (key.has("target")) k.target = key.member("target").vec3();
+    if (key.has("up")) k.up = key.member("up").vec3();
+    checkView(key, k.position, k.target, k.up);
+    keys.push_back(k);
+  }
+  return keys;
+}
+
+CameraDesc readCamera(const Node& n) {
+  n.expectObject({"position", "target", "up", "fov", "resolution", "shutter", "motion"});
+  CameraDesc cam;
+  if (n.has("position")) cam.position = n.member("position").vec3();
+  if (n.has("target")) cam.target = n.member("target").vec3();
+  if (n.has("up")) cam.up = n.member("up").vec3();
+  checkView(n, cam.position, cam.target, cam.up);
+  if (n.has("fov")) {
+    Node f = n.member("fov");
+    cam.fovDegrees = f.number();
+    f.require(cam.fovDegrees > 0 && cam.fovDegrees < 180, "fov must be in (0, 180) degrees, got " + fmt(cam.fovDegrees));
+  }
+  if (n.has("resolution")) readResolution(n.member("resolution"), &cam);
+  if (n.has("shutter")) readShutter(n.member("shutter"), &cam);
+  if (n.has("motion")) cam.motion = readCameraMotion(n.member("motion"), cam);
+  return cam;
+}
+
+// ---------------------------------------------------------------- materials
+
+TextureDesc readTexture(const Node& n) {
+  n.requireObject();
+  std::string kind = n.required("type").choice({"constant", "checker"}, "texture type");
+  TextureDesc t;
+  if (kind == "constant") {
+    n.expectObject({"type", "color"});
+    if (n.has("color")) t.color = readReflectance(n.member("color"));
+    return t;
+  }
+  n.expectObject({"type", "colors", "scale"});
+  t.kind = TextureDesc::Kind::Checker;
+  if (n.has("colors")) {
+    Node c = n.member("colors");
+    size_t size = c.arraySize("2 colours");
+    c.require(size == 2, "expected an array of 2 colours, got " + detail::describeKind(c.json()));
+    t.color = readReflectance(c.element(0));
+    t.color2 = readReflectance(c.element(1));
+  }
+  if (n.has("scale")) t.scale = readPositive(n.member("scale"), "checker scale (cell size)");
+  return t;
+}
+
+// Diffuse reflectance / plastic base colour: "color" or "texture".
+TextureDesc readAlbedo(const Node& n) {
+  if (n.has("color") && n.has("texture"))
+    n.member("texture").fail("give either \"color\" or \"texture\", not both");
+  TextureDesc t;
+  if (n.has("color")) t.color = readReflectance(n.member("color"));
+  if (n.has("texture")) t = readTexture(n.member("texture"));
+  return t;
+}
+
+float readIor(const Node& n) {
+  float ior = n.number();
+  n.require(ior >= 1, "ior must be at least 1, got " + fmt(ior));
+  return ior;
+}
+
+float readRoughness(const Node& n) {
+  float r = n.number();
+  n.require(r > 0 && r <= 1, "roughness must be in (0, 1], got " + fmt(r));
+  return r;
+}
+
+struct MaterialKind {
+  const char* name;
+  MaterialDesc::Type type;
+  std::vector<std::string> keys;
+};
+
+const std::vector<MaterialKind>& materialKinds() {
+  static const std::vector<MaterialKind> kinds = {
+      {"diffuse", MaterialDesc::Type::Diffuse, {"type", "color", "texture"}},
+      {"mirror", MaterialDesc::Type::Mirror, {"type", "color"}},
+      {"dielectric", MaterialDesc::Type::Dielectric, {"type", "ior", "tint"}},
+      {"metal", MaterialDesc::Type::Metal, {"type", "color", "roughness"}},
+      {"plastic", MaterialDesc::Type::Plastic, {"type", "color", "texture", "ior", "roughness"}},
+  };
+  return kinds;
+}
+
+MaterialDesc readMaterial(const Node& n, const std::string& name) {
+  n.requireObject();
+  std::vector<std::string> names;
+  for (const auto& k : materialKinds()) names.push_back(k.name);
+  std::string typeName = n.required("type").choice(names, "material type");
+  const MaterialKind& kind = *std::find_if(materialKinds().begin(), materialKinds().end(),
+                                           [&](const MaterialKind& k) { return typeName == k.name; });
+  n.expectObject(kind.keys);
+  MaterialDesc m;
+  m.name = name;
+  m.type = kind.type;
+  bool albedo = kind.type == MaterialDesc::Type::Diffuse || kind.type == MaterialDesc::Type::Plastic;
+  if (albedo) m.albedo = readAlbedo(n);
+  else if (n.has("color")) m.specular = readReflectance(n.member("color"));
+  if (n.has("tint")) m.specular = readReflectance(n.member("tint"));
+  if (n.has("ior")) m.ior = readIor(n.member("ior"));
+  if (n.has("roughness")) m.roughness = readRoughness(n.member("roughness"));
+  return m;
+}
+
+std::vector<MaterialDesc> readMaterials(const Node& n) {
+  std::vector<MaterialDesc> out;
+  n.forEachMember([&](const std::string& name, const Node& m) {
+    m.require(!name.empty(), "material names must not be empty");
+    out.push_back(readMaterial(m, name));
+  });
+  return out;
+}
+
+// Objects without "material" use "default": the file's own, or else this.
+constexpr const char* kDefaultMaterial = "default";
+
+uint32_t resolveMaterial(const Node& object, std::vector<MaterialDesc>* materials) {
+  std::string name = kDefaultMaterial;
+  if (object.has("material")) {
+    Node n = object.member("material");
+    if (!n.json().is_string()) n.fail("expected a string (a material name), got " + detail::describeKind(n.json()));
+    name = n.string();
+  }
+  for (size_t i = 0; i < materials->size(); ++i)
+    if ((*materials)[i].name == name) return uint32_t(i);
+  if (!object.has("material")) {
+    MaterialDesc grey;  // diffuse, reflectance 0.8
+    grey.name = kDefaultMaterial;
+    materials->push_back(grey);
+    return uint32_t(materials->size() - 1);
+  }
+  std::vector<std::string> defined;
+  for (const auto& m : *materials) defined.push_back(m.name);
+  object.member("material").fail("unknown material \"" + name + "\"; " +
+                                 (defined.empty() ? "no materials are defined" : "defined materials: " + joinNames(defined)));
+}
+
+// ---------------------------------------------------------------- shapes
+
+std::string resolveMeshPath(const std::string& file, const std::string& sceneDir) {
+  std::filesystem::path p(file);
+  if (p.is_absolute() || sceneDir.empty()) return p.lexically_normal().string();
+  return (std::filesystem::path(sceneDir) / p).lexically_normal().string();
+}
+
+void readMesh(const Node& n, const std::string& sceneDir, ShapeDesc* shape) {
+  Node fileNode = n.required("file");
+  std::string file = fileNode.string();
+  fileNode.require(!file.empty(), "mesh file name must not be empty");
+  shape->meshFile = resolveMeshPath(file, sceneDir);
+  ObjMesh mesh;
+  std::string problem;
+  if (!loadObjMesh(shape->meshFile, &mesh, &problem)) fileNode.fail(problem);
+  shape->vertices = std::move(mesh.vertices);
+  shape->indices = std::move(mesh.indices);
+}
+
+ShapeDesc readShape(const Node& n, const std::string& sceneDir) {
+  n.requireObject();
+  std::string type = n.required("type").choice({"sphere", "quad", "box", "mesh"}, "shape type");
+  ShapeDesc s;
+  if (type == "sphere") {
+    n.expectObject({"type", "radius"});
+    s.type = ShapeDesc::Type::Sphere;
+    if (n.has("radius")) s.radius = readPositive(n.member("radius"), "radius");
+  } else if (type == "quad") {
+    n.expectObject({"type", "size"});
+    s.type = ShapeDesc::Type::Quad;
+    if (n.has("size")) {
+      Node sz = n.member("size");
+      Vec2f v = sz.vec2();
+      sz.require(v.x > 0 && v.y > 0, "size must be positive in every dimension, got [" + fmt(v.x) + ", " + fmt(v.y) + "]");
+      s.size = {v.x, 1.0f, v.y};  // a quad spans x and z; y is unused
+    }
+  } else if (type == "box") {
+    n.expectObject({"type", "size"});
+    s.type = ShapeDesc::Type::Box;
+    if (n.has("size")) {
+      Node sz = n.member("size");
+      s.size = sz.vec3();
+      sz.require(s.size.x > 0 && s.size.y > 0 && s.size.z > 0,
+                 "size must be positive in every dimension, got " + formatVec(s.size));
+    }
+  } else {
+    n.expectObject({"type", "file"});
+    s.type = ShapeDesc::Type::Mesh;
+    readMesh(n, sceneDir, &s);
+  }
+  return s;
+}
+
+// ---------------------------------------------------------------- objects
+
+std::string readName(const Node& n, const std::string& fallback) {
+  if (!n.has("name")) return fallback;
+  Node name = n.member("name");
+  std::string s = name.string();
+  name.require(!s.empty(), "name must not be empty");
+  return s;
+}
+
+ObjectDesc readObject(const Node& n, std::vector<MaterialDesc>* materials, Shutter s, const std::string& sceneDir) {
+  n.expectObject({"name", "shape", "material", "transform", "motion"});
+  ObjectDesc o;
+  o.name = readName(n, n.path());
+  o.shape = readShape(n.required("shape"), sceneDir);
+  o.material = resolveMaterial(n, materials);
+  if (n.has("transform")) o.placement = readTransform(n.member("transform"));
+  if (n.has("motion")) o.motion = readMotion(n.member("motion"), s);
+  return o;
+}
+
+// ---------------------------------------------------------------- lights
+
+struct LightKind {
+  const char* name;
+  LightDesc::Type type;
+  std::vector<std::string> keys;  // besides type, name, transform, motion
+};
+
+const std::vector<LightKind>& lightKinds() {
+  static const std::vector<LightKind> kinds = {
+      {"point", LightDesc::Type::Point, {"position", "power"}},
+      {"spot", LightDesc::Type::Spot, {"position", "target", "direction", "cone_angle", "falloff_start", "power"}},
+      {"directional", LightDesc::Type::Directional, {"direction", "irradiance"}},
+      {"area", LightDesc::Type::Area, {"size", "power"}},
+  };
+  return kinds;
+}
+
+void readSpot(const Node& n, LightDesc* l) {
+  if (n.has("target") && n.has("direction")) n.member("direction").fail("give either \"target\" or \"direction\", not both");
+  if (n.has("target")) {
+    Node t = n.member("target");
+    Vec3f target = t.vec3();
+    t.require(!isZero(target - l->position), "spot target equals its position " + formatVec(target));
+    l->direction = safeNormalize(target - l->position);
+  }
+  if (n.has("direction")) l->direction = readDirection(n.member("direction"));
+  if (n.has("cone_angle")) {
+    Node c = n.member("cone_angle");
+    l->coneAngle = c.number();
+    c.require(l->coneAngle > 0 && l->coneAngle <= 90, "cone_angle must be in (0, 90] degrees, got " + fmt(l->coneAngle));
+  }
+  // Unless given, the falloff starts at 5/6 of the cone (25 of the default 30).
+  l->falloffStart = l->coneAngle * (25.0f / 30.0f);
+  if (n.has("falloff_start")) {
+    Node f = n.member("falloff_start");
+    l->falloffStart = f.number();
+    f.require(l->falloffStart >= 0 && l->falloffStart <= l->coneAngle,
+              "falloff_start must be in [0, cone_angle = " + fmt(l->coneAngle) + "] degrees, got " + fmt(l->falloffStart));
+  }
+}
+
+void readAreaSize(const Node& n, LightDesc* l) {
+  Vec2f v = n.vec2();
+  n.require(v.x > 0 && v.y > 0, "size must be positive in every dimension, got [" + fmt(v.x) + ", " + fmt(v.y) + "]");
+  l->areaSize = v;
+}
+
+LightDesc readLight(const Node& n, Shutter s) {
+  n.requireObject();
+  std::vector<std::string> names;
+  for (const auto& k : lightKinds()) names.push_back(k.name);
+  std::string typeName = n.required("type").choice(names, "light type");
+  const LightKind& kind = *std::find_if(lightKinds().begin(), lightKinds().end(),
+                                        [&](const LightKind& k) { return typeName == k.name; });
+  if (kind.type == LightDesc::Type::Directional && n.has("power"))
+    n.member("power").fail("a directional light takes \"irradiance\" (W/m^2), not \"power\": a sun has no finite power");
+  std::vector<std::string> keys = {"type", "name", "transform", "motion"};
+  keys.insert(keys.end(), kind.keys.begin(), kind.keys.end());
+  n.expectObject(keys);
+
+  LightDesc l;
+  l.type = kind.type;
+  l.name = readName(n, n.path());
+  if (n.has("power")) l.power = n.member("power").color();
+  if (n.has("irradiance")) l.power = n.member("irradiance").color();
+  if (n.has("position")) l.position = n.member("position").vec3();
+  if (kind.type == LightDesc::Type::Directional && n.has("direction"))
+    l.direction = readDirection(n.member("direction"));
+  if (kind.type == LightDesc::Type::Spot) readSpot(n, &l);
+  if (n.has("size")) readAreaSize(n.member("size"), &l);
+  if (n.has("transform")) l.placement = readTransform(n.member("transform"));
+  if (n.has("motion")) l.motion = readMotion(n.member("motion"), s);
+  return l;
+}
+
+// ---------------------------------------------------------------- render
+
+int readCount(const Node& n, const char* what) {
+  int64_t v = n.integer();
+  n.require(v >= 1, std::string(what) + " must be at least 1, got " + std::to_string(v));
+  n.require(v <= INT_MAX, std::string(what) + " " + std::to_string(v) + " is too large");
+  return int(v);
+}
+
+uint64_t readSeed(const Node& n) {
+  const Json& j = n.json();
+  if (j.is_number_unsigned()) return j.get<uint64_t>();
+  double d = j.is_number() ? j.get<double>() : -1.0;
+  // Integral floats (1e3) are accepted up to 2^53, where doubles are exact.
+  if (!(d >= 0) || d != std::floor(d) || d > 9007199254740992.0)
+    n.fail("seed must be a non-negative integer, got " + (j.is_number() ? j.dump() : detail::describeKind(j)));
+  return uint64_t(d);
+}
+
+const std::vector<std::string> kMethods = {"pathtrace", "static", "accumulation", "standard", "time"};
+
+const std::vector<std::string> kSearches = {"twopass", "4d"};
+const std::vector<std::string> kSpaceKernels = {"uniform", "cone", "epanechnikov"};
+const std::vector<std::string> kTimeKernels = {"uniform", "epanechnikov"};
+
+int64_t readPhotonCount(const Node& n, const char* what) {
+  int64_t v = n.integer();
+  n.require(v >= 0, std::string(what) + " must be at least 0, got " + std::to_string(v));
+  // 2^31 photons at 20 bytes is 40 GiB: more is certainly a typo.
+  n.require(v <= (int64_t(1) << 31), std::string(what) + " " + std::to_string(v) + " is too large (at most 2^31)");
+  return v;
+}
+
+RenderSettings readRender(const Node& n) {
+  n.expectObject({"method", "spp", "max_spp", "contrast", "seed", "max_depth", "exposure", "photons", "global_photons",
+                  "frames", "search", "k", "fraction", "kappa", "max_radius", "max_dt", "kernel_space", "kernel_time",
+                  "gather"});
+  RenderSettings r;
+  if (n.has("method")) r.method = n.member("method").choice(kMethods, "render method");
+  if (n.has("spp")) r.spp = readCount(n.member("spp"), "spp");
+  if (n.has("max_spp")) r.maxSpp = readCount(n.member("max_spp"), "max_spp");
+  if (n.has("contrast")) r.contrast = readPositive(n.member("contrast"), "contrast");
+  if (n.has("seed")) r.seed = readSeed(n.member("seed"));
+  if (n.has("max_depth")) r.maxDepth = readCount(n.member("max_depth"), "max_depth");
+  if (n.has("exposure")) r.exposure = n.member("exposure").number();
+  if (n.has("photons")) r.photons = readPhotonCount(n.member("photons"), "photons");
+  if (n.has("global_photons")) r.globalPhotons = readPhotonCount(n.member("global_photons"), "global_photons");
+  if (n.has("frames")) r.frames = readCount(n.member("frames"), "frames");
+  if (n.has("search")) r.search = n.member("search").choice(kSearches, "search");
+  if (n.has("k")) r.k = readCount(n.member("k"), "k");
+  if (n.has("fraction")) {
+    const Node f = n.member("fraction");
+    float v = f.number();
+    f.require(v > 0 && v <= 1, "fraction must be in (0, 1], got " + f.json().dump());
+    r.fraction = v;
+  }
+  if (n.has("kappa")) r.kappa = readPositive(n.member("kappa"), "kappa");
+  if (n.has("max_radius")) r.maxRadius = readPositive(n.member("max_radius"), "max_radius");
+  if (n.has("max_dt")) r.maxDt = readPositive(n.member("max_dt"), "max_dt");
+  if (n.has("kernel_space")) r.kernelSpace = n.member("kernel_space").choice(kSpaceKernels, "space kernel");
+  if (n.has("kernel_time")) r.kernelTime = n.member("kernel_time").choice(kTimeKernels, "time kernel");
+  if (n.has("gather")) {
+    const Node g = n.member("gather");
+    int64_t v = g.integer();
+    g.require(v >= 0 && v <= 1024, "gather must be in [0, 1024], got " + std::to_string(v));
+    r.gather = int(v);
+  }
+  return r;
+}
+
+// ---------------------------------------------------------------- scene
+
+SceneDescription readScene(const Node& root, const std::string& sourcePath) {
+  root.expectObject({"camera", "materials", "objects", "lights", "background", "render"});
+  SceneDescription scene;
+  scene.sourcePath = sourcePath;
+  scene.camera = readCamera(root.required("camera"));
+  Shutter shutter{scene.camera.shutterOpen, scene.camera.shutterClose};
+  if (root.has("materials")) scene.materials = readMaterials(root.member("materials"));
+  std::string sceneDir = std::filesystem::path(sourcePath).parent_path().string();
+  Node objects = root.required("objects");
+  size_t count = objects.arraySize("objects");
+  for (size_t i = 0; i < count; ++i)
+    scene.objects.push_back(readObject(objects.element(i), &scene.materials, shutter, sceneDir));
+  if (root.has("lights")) {
+    Node lights = root.member("lights");
+    size_t n = lights.arraySize("lights");
+    for (size_t i = 0; i < n; ++i) scene.lights.push_back(readLight(lights.element(i), shutter));
+  }
+  if (root.has("background")) scene.background = root.member("background").color();
+  if (root.has("render")) scene.render = readRender(root.member("render"));
+  return scene;
+}
+
+// ---------------------------------------------------------------- text level
+
+[[noreturn]] void failAt(const std::string& file, const std::string& text, size_t offset, const std::string& problem) {
+  TextPosition p = positionOf(text, offset);
+  throw Error(file + ":" + std::to_string(p.line) + ":" + std::to_string(p.column) + ": " + problem);
+}
+
+// Checks that do not need parsed JSON: empty text, bad UTF-8.
+void checkText(const std::string& text, const std::string& file) {
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos)
+    throw Error(file + ":1: the file is empty (expected a JSON object)");
+  size_t bad = firstInvalidUtf8(text);
+  if (bad != std::string::npos) {
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "0x%02X", unsigned(static_cast<unsigned char>(text[bad])));
+    failAt(file, text, bad, std::string("not valid UTF-8 text (byte ") + hex + "); is this a JSON scene file?");
+  }
+}
+
+// nlohmann's message minus its own "[json.exception...] parse error at ...: " prefix.
+std::string syntaxDetail(const std::string& what) {
+  size_t at = what.find("syntax error");
+  if (at != std::string::npos) return what.substr(at);
+  size_t colon = what.find("]");
+  return "syntax error: " + (colon == std::string::npos ? what : what.substr(colon + 2));
+}
+
+// nlohmann rejects number literals that overflow a double (1e999) by
+// spelling only; find the value to report its path and line.
+[[noreturn]] void failOverflow(const std::string& text, const std::string& file, const std::string& what) {
+  size_t open = what.find('\''), close = what.rfind('\'');
+  std::string token = (open != std::string::npos && close > open) ? what.substr(open + 1, close - open - 1) : "";
+  JsonLocator locator(text);
+  Source source{file, &locator};
+  source.fail(locator.findNumber(token), "number " + token + " is not finite (it overflows)");
+}
+
+Json parseJson(const std::string& text, const std::string& file) {
+  checkText(text, file);
+  try {
+    return Json::parse(text);
+  } catch (const Json::parse_error& e) {
+    failAt(file, text, e.byte > 0 ? e.byte - 1 : 0, syntaxDetail(e.what()));
+  } catch (const Json::out_of_range& e) {
+    failOverflow(text, file, e.what());
+  } catch (const Json::exception& e) {
+    throw Error(file + ": invalid JSON: " + e.what());
+  }
+}
+
+}  // namespace
+
+SceneDescription parseScene(const std::string& jsonText, const std::string& sourcePath) {
+  Json doc = parseJson(jsonText, sourcePath);
+  JsonLocator locator(jsonText);
+  if (!locator.duplicates().empty()) {
+    const auto& d = locator.duplicates().front();
+    throw Error(sourcePath + ":" + std::to_string(d.line) + ": " + d.path + ": duplicate key (each key may appear only once)");
+  }
+  Source source{sourcePath, &locator};
+  return readScene(Node(doc, "", source), sourcePath);
+}
+
+SceneDescription loadScene(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw Error(path + ": cannot read scene file: it is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot read scene file (" + std::strerror(errno) + ")");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw Error(path + ": error while reading scene file");
+  return parseScene(text.str(), path);
+}
+
+}  // namespace tdpm::scene

@@ -1,0 +1,58 @@
+// tests/cli_harness.h — runs build/tdpm as a user would (through the shell)
+// and captures its exit code and combined output; temporary directories.
+#pragma once
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+namespace tdpm::test {
+
+struct CommandResult {
+  int exitCode = -1;
+  std::string output;  // stdout and stderr together
+};
+
+inline CommandResult runTdpm(const std::string& args) {
+  std::string cmd = std::string("'") + TDPM_BINARY + "' " + args + " 2>&1 < /dev/null";
+  CommandResult r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  int status = pclose(p);
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+inline std::string makeTempDir() {
+  char tmpl[] = "/tmp/tdpm-test-XXXXXX";
+  char* d = mkdtemp(tmpl);
+  return d ? std::string(d) : std::string("/tmp");
+}
+
+inline bool fileExists(const std::string& path) {
+  struct stat st;
+  return stat(path.c_str(), &st) == 0;
+}
+
+inline void writeFile(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
+
+// Files in a directory (names), to check nothing half-written is left.
+inline int countEntries(const std::string& dir) {
+  std::string cmd = "ls -A '" + dir + "' | wc -l";
+  FILE* p = popen(cmd.c_str(), "r");
+  int n = -1;
+  if (p) {
+    if (fscanf(p, "%d", &n) != 1) n = -1;
+    pclose(p);
+  }
+  return n;
+}
+
+}  // namespace tdpm::test
