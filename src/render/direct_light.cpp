@@ -8,7 +8,7 @@
 namespace tdpm {
 
 Rgb directLight(const Scene& scene, const Hit& hit, const ShadingContext& ctx, float time01, Rng& rng,
-                bool misWithBsdf) {
+                int bsdfSamples) {
   Rgb sum(0.0f);
   for (const Light& light : scene.lights) {
     LightSample ls;
@@ -24,7 +24,7 @@ Rgb directLight(const Scene& scene, const Hit& hit, const ShadingContext& ctx, f
     if (light.isDelta()) {
       sum += f * ls.li * cosTheta;
     } else {
-      float w = misWithBsdf ? powerHeuristic(ls.pdf, bsdfPdf(ctx, ls.wi)) : 1.0f;
+      float w = bsdfSamples > 0 ? 1.0f - emissionWeight(bsdfPdf(ctx, ls.wi), ls.pdf, bsdfSamples) : 1.0f;
       sum += f * ls.li * (cosTheta * w / ls.pdf);
     }
   }

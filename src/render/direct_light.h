@@ -1,8 +1,9 @@
 // render/direct_light.h — next-event estimation shared by the integrators:
-// one shadow ray per light at the path's time. With `misWithBsdf`, area
-// lights are weighted by the power heuristic against BSDF sampling (the
-// caller then adds MIS-weighted emission when a BSDF-sampled ray hits a
-// light); without it they count in full (the caller ignores such hits).
+// one shadow ray per light at the path's time. Area lights are combined
+// with `bsdfSamples` BSDF-sampled rays by Veach's multi-sample power
+// heuristic, w = p_l^2 / (p_l^2 + (n p_b)^2); the caller adds those rays'
+// emission with emissionWeight(). bsdfSamples = 0: light sampling alone,
+// at full weight (the caller then ignores emission its rays hit).
 #pragma once
 #include "core/rng.h"
 #include "scene/bsdf.h"
@@ -11,6 +12,14 @@
 namespace tdpm {
 
 Rgb directLight(const Scene& scene, const Hit& hit, const ShadingContext& ctx, float time01, Rng& rng,
-                bool misWithBsdf);
+                int bsdfSamples);
+
+// MIS weight of a BSDF-sampled ray (one of `bsdfSamples`, density
+// bsdfPdf) that hit an area light which light sampling would have chosen
+// with density lightPdf.
+inline float emissionWeight(float bsdfPdf, float lightPdf, int bsdfSamples) {
+  float b = float(bsdfSamples) * bsdfPdf;
+  return b * b / (b * b + lightPdf * lightPdf);
+}
 
 }  // namespace tdpm

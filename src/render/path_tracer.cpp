@@ -32,7 +32,7 @@ Rgb PathTracer::radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const 
       AreaLightFrame f = areaLightFrame(light, time01);
       Rgb le = areaLightRadiance(light, f, -dir);
       if (!le.isBlack()) {
-        float w = lastDelta ? 1.0f : powerHeuristic(lastPdf, areaLightPdf(light, f, lastP, hit.p));
+        float w = lastDelta ? 1.0f : emissionWeight(lastPdf, areaLightPdf(light, f, lastP, hit.p), 1);
         L += beta * le * w;
       }
       break;  // emitters do not reflect
@@ -41,7 +41,7 @@ Rgb PathTracer::radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const 
     ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
 
     // ---- next-event estimation ----
-    if (!mat.isDeltaOnly()) L += beta * directLight(scene_, hit, ctx, time01, rng, /*misWithBsdf=*/true);
+    if (!mat.isDeltaOnly()) L += beta * directLight(scene_, hit, ctx, time01, rng, /*bsdfSamples=*/1);
 
     // ---- continue the path ----
     BsdfSample bs;

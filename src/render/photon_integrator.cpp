@@ -68,7 +68,18 @@ Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, flo
         break;
       }
       moved = moved || scene_.segmentMeetsMotion(o, d, h.t);
-      if (h.isLight()) break;  // direct light was counted by the shadow rays
+      if (h.isLight()) {
+        // Seen straight from the gather point: the BSDF-sampled half of
+        // direct light (MIS with the shadow rays). Through mirrors or
+        // glass it is a caustic, which the caustic map holds.
+        if (bounce == 0) {
+          const Light& light = scene_.lights[size_t(h.light)];
+          AreaLightFrame f = areaLightFrame(light, time01);
+          float w = emissionWeight(bs.pdf, areaLightPdf(light, f, hit.p, h.p), s_.gatherRays);
+          sum += beta * areaLightRadiance(light, f, -d) * w;
+        }
+        break;
+      }
       const Material& m = scene_.materials[scene_.objects[h.object].material];
       ShadingContext c = makeShadingContext(m, m.albedo.at(h.localP), h.n, -d);
       if (!m.isDeltaOnly()) {
@@ -117,9 +128,10 @@ Rgb PhotonIntegrator::radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng, 
         L += beta * estimate(global_, ts.global, ts.global3, hit, ctx, -dir, time01, timeDependent, ts.counts);
         break;
       }
-      L += beta * directLight(scene_, hit, ctx, time01, rng, /*misWithBsdf=*/false);
+      bool gather = global_ && global_->size() > 0 && s_.gatherRays > 0;
+      L += beta * directLight(scene_, hit, ctx, time01, rng, gather ? s_.gatherRays : 0);
       L += beta * estimate(caustic_, ts.caustic, ts.caustic3, hit, ctx, -dir, time01, timeDependent, ts.counts);
-      if (global_ && global_->size() > 0) L += beta * finalGather(hit, ctx, time01, touched, rng, ts);
+      if (gather) L += beta * finalGather(hit, ctx, time01, touched, rng, ts);
       break;
     }
 
