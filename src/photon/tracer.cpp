@@ -13,6 +13,8 @@
 
 #include "core/rng.h"
 #include "core/timer.h"
+#include "math/frame.h"
+#include "sampling/warp.h"
 #include "scene/bsdf.h"
 
 namespace tdpm::photon {
@@ -50,12 +52,154 @@ struct LightTable {
   }
 };
 
-LightTable makeLightTable(const Scene& scene) {
+// ---- projection maps (Jensen 2001, sec. 5.3), as bounding spheres ----
+// A caustic path's first hit must be a specular (delta-only) surface, so
+// the caustic map only needs photons emitted toward the swept bounding
+// spheres of specular objects. Directions (or, for a sun, points on the
+// emission disc) are drawn from a mixture over those targets; the flux is
+// divided by the mixture density (the number of targets covering the
+// sample over their total measure), so energies stay exact however the
+// targets overlap.
+struct Target {
+  Vec3f centre;
+  float radius;
+};
+
+std::vector<Target> specularTargets(const Scene& scene) {
+  std::vector<Target> t;
+  for (const SceneObject& o : scene.objects)
+    if (scene.materials[o.material].isDeltaOnly())
+      t.push_back({o.sweptBounds.center(), 0.5f * length(o.sweptBounds.diagonal()) * 1.001f + 1e-6f});
+  return t;
+}
+
+// Cosine of the half-angle of the cone from x that holds the sphere; -1
+// (every direction) when x is inside it.
+float coneCos(const Target& t, Vec3f x) {
+  float d2 = lengthSquared(t.centre - x);
+  float r2 = t.radius * t.radius;
+  return d2 <= r2 ? -1.0f : std::sqrt(1.0f - r2 / d2);
+}
+
+// Direction from x toward the targets; returns the solid-angle density of
+// the mixture at the chosen direction (0: no target).
+float sampleTowardTargets(const std::vector<Target>& targets, Vec3f x, Vec3f uvw, Vec3f& dir) {
+  float total = 0;
+  for (const Target& t : targets) total += 2.0f * kPi * (1.0f - coneCos(t, x));
+  if (!(total > 0)) return 0.0f;
+  float pick = uvw.x * total, acc = 0;
+  size_t j = 0;
+  for (; j + 1 < targets.size(); ++j) {
+    acc += 2.0f * kPi * (1.0f - coneCos(targets[j], x));
+    if (pick < acc) break;
+  }
+  float cosMax = coneCos(targets[j], x);
+  Vec3f local = cosMax <= -1.0f ? squareToUniformSphere({uvw.y, uvw.z}) : squareToUniformCone({uvw.y, uvw.z}, cosMax);
+  dir = cosMax <= -1.0f ? local : Frame(normalize(targets[j].centre - x)).toWorld(local);
+  int covering = 0;
+  for (const Target& t : targets) {
+    float c = coneCos(t, x);
+    covering += c <= -1.0f || dot(dir, normalize(t.centre - x)) >= c;
+  }
+  return float(std::max(covering, 1)) / total;
+}
+
+// Caustic-map emission of one light toward the targets. flux = emitted
+// radiometric quantity / density, as in emitFromLight.
+bool emitTowardTargets(const Light& light, const std::vector<Target>& targets, float time01, const Bounds3f& bounds,
+                       Rng& rng, EmittedRay& out) {
+  Vec3f uvw{rng.uniform(), rng.uniform(), rng.uniform()};
+  switch (light.type) {
+    case Light::Type::Point:
+    case Light::Type::Spot: {
+      Affine3f m = light.motion.atNormalized(time01);
+      Vec3f p = m.point(light.position);
+      float pdf = sampleTowardTargets(targets, p, uvw, out.direction);
+      if (!(pdf > 0)) return false;
+      Rgb i = light.intensity;
+      if (light.type == Light::Type::Spot) {
+        float f = light.spotFalloff(dot(out.direction, normalize(m.vector(light.direction))));
+        if (f <= 0) return false;
+        i = i * f;
+      }
+      out.origin = p;
+      out.flux = i / pdf;
+      return true;
+    }
+    case Light::Type::Area: {
+      AreaLightFrame fr = areaLightFrame(light, time01);
+      if (!(fr.area > 0)) return false;
+      Vec3f q = fr.center + fr.edgeX * (rng.uniform() - 0.5f) + fr.edgeZ * (rng.uniform() - 0.5f);
+      float pdf = sampleTowardTargets(targets, q, uvw, out.direction);
+      float cosT = dot(out.direction, fr.normal);
+      if (!(pdf > 0) || cosT <= 0) return false;
+      out.origin = q;
+      out.flux = areaLightRadiance(light, fr, out.direction) * (cosT * fr.area / pdf);
+      return true;
+    }
+    case Light::Type::Directional: {
+      // The sun's emission disc, restricted to the targets' shadows on it.
+      Affine3f m = light.motion.atNormalized(time01);
+      Vec3f d = normalize(m.vector(light.direction));
+      Vec3f c = bounds.empty() ? Vec3f(0, 0, 0) : bounds.center();
+      float R = bounds.empty() ? 1.0f : 0.5f * length(bounds.diagonal()) * 1.001f + 1e-6f;
+      float total = 0;
+      for (const Target& t : targets) total += kPi * t.radius * t.radius;
+      if (!(total > 0)) return false;
+      float pick = uvw.x * total, acc = 0;
+      size_t j = 0;
+      for (; j + 1 < targets.size(); ++j) {
+        acc += kPi * targets[j].radius * targets[j].radius;
+        if (pick < acc) break;
+      }
+      Frame f(d);
+      Vec2f disk = squareToConcentricDisk({uvw.y, uvw.z});
+      Vec3f onPlane = targets[j].centre - d * dot(d, targets[j].centre - c) +
+                      (f.s * disk.x + f.t * disk.y) * targets[j].radius;
+      int covering = 0;
+      for (const Target& t : targets) {
+        Vec3f tc = t.centre - d * dot(d, t.centre - c);
+        covering += lengthSquared(onPlane - tc) <= t.radius * t.radius;
+      }
+      out.origin = onPlane - d * (R + std::fabs(dot(d, onPlane - c)));
+      out.direction = d;
+      out.flux = light.power * (total / float(std::max(covering, 1)));
+      return true;
+    }
+  }
+  return false;
+}
+
+// What a light can send at the targets (luminance), to choose lights for
+// the caustic map: a cone's or disc's worth of its intensity or irradiance.
+double powerTowardTargets(const Light& light, const std::vector<Target>& targets) {
+  double sum = 0;
+  switch (light.type) {
+    case Light::Type::Point:
+    case Light::Type::Spot: {
+      Vec3f p = light.motion.atNormalized(0.5f).point(light.position);
+      for (const Target& t : targets) sum += 2.0 * kPi * (1.0 - coneCos(t, p));
+      double cap = light.type == Light::Type::Spot ? 2.0 * kPi * (1.0 - light.cosTotal) : 4.0 * kPi;
+      return light.intensity.average() * std::min(sum, cap);
+    }
+    case Light::Type::Area:
+      return light.power.average();
+    case Light::Type::Directional:
+      for (const Target& t : targets) sum += kPi * double(t.radius) * t.radius;
+      return light.power.average() * sum;
+  }
+  return 0;
+}
+
+// Lights chosen by emitted power (global map) or by power sent toward the
+// specular targets (caustic map).
+LightTable makeLightTable(const Scene& scene, const std::vector<Target>* targets) {
   LightTable t;
   double total = 0;
   std::vector<double> w;
   for (const Light& l : scene.lights) {
-    double p = std::max(0.0f, emittedPower(l, scene.bounds).average());
+    double p = targets ? powerTowardTargets(l, *targets) : std::max(0.0f, emittedPower(l, scene.bounds).average());
+    p = std::max(0.0, p);
     w.push_back(p);
     total += p;
   }
@@ -73,27 +217,36 @@ LightTable makeLightTable(const Scene& scene) {
 struct Tracer {
   const Scene& scene;
   const TraceSettings& settings;
+  std::vector<Target> targets;  // caustic map: where photons are aimed
   LightTable lights;
   float t0, t1, ts;
   uint32_t timeScramble;
 
   // Traces paths [first, first + count) of batch `b` into `out`, energies
   // scaled by `energyScale` (= ts / n_e). Returns nothing: out grows.
-  void traceBatch(uint64_t b, double energyScale, PhotonStore& out) const {
+  // Returns the number of rays cast.
+  uint64_t traceBatch(uint64_t b, double energyScale, PhotonStore& out) const {
     Rng rng(hashCombine(settings.seed, uint64_t(settings.kind) + 1, b), 0x9e37);
+    uint64_t rays = 0;
     for (uint32_t i = 0; i < kPathsPerBatch; ++i) {
       uint64_t g = b * kPathsPerBatch + i;
       float time01 = settings.spreadInTime ? scrambledVanDerCorput(uint32_t(g), timeScramble) : settings.fixedTime01;
-      tracePath(time01, rng, energyScale, out);
+      rays += tracePath(time01, rng, energyScale, out);
     }
+    return rays;
   }
 
-  void tracePath(float time01, Rng& rng, double energyScale, PhotonStore& out) const {
+  uint64_t tracePath(float time01, Rng& rng, double energyScale, PhotonStore& out) const {
+    uint64_t rays = 0;
     uint32_t li = lights.pick(rng.uniform());
     const Light& light = scene.lights[li];
     EmittedRay ray;
-    Vec2f uPos{rng.uniform(), rng.uniform()}, uDir{rng.uniform(), rng.uniform()};
-    if (!emitFromLight(light, time01, scene.bounds, uPos, uDir, ray)) return;
+    if (settings.kind == MapKind::Caustic && settings.projection) {
+      if (!emitTowardTargets(light, targets, time01, scene.bounds, rng, ray)) return rays;
+    } else {
+      Vec2f uPos{rng.uniform(), rng.uniform()}, uDir{rng.uniform(), rng.uniform()};
+      if (!emitFromLight(light, time01, scene.bounds, uPos, uDir, ray)) return rays;
+    }
     Rgb power = ray.flux / lights.pdf[li];
     float time = scene.shutter.instant() ? t0 : scene.shutter.fromNormalized(time01);
     // Off the emitter's surface: an area light is geometry, and a photon
@@ -102,41 +255,46 @@ struct Tracer {
     bool allSpecular = true;  // every bounce so far was a delta reflection/refraction
     for (int bounce = 0; bounce <= settings.maxBounces; ++bounce) {
       Hit hit;
-      if (!scene.intersect(origin, dir, std::numeric_limits<float>::infinity(), time01, hit)) return;
-      if (hit.isLight()) return;  // emitters absorb
+      ++rays;
+      if (!scene.intersect(origin, dir, std::numeric_limits<float>::infinity(), time01, hit)) return rays;
+      if (hit.isLight()) return rays;  // emitters absorb
       const Material& mat = scene.materials[scene.objects[hit.object].material];
       if (!mat.isDeltaOnly()) {
         bool store = settings.kind == MapKind::Global || (bounce > 0 && allSpecular);
         if (store) out.add(hit.p, power * float(energyScale), -dir, time);
-        if (settings.kind == MapKind::Caustic) return;  // L S+ D ends here
+        if (settings.kind == MapKind::Caustic) return rays;  // L S+ D ends here
       }
       ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
       BsdfSample bs;
       Vec2f u{rng.uniform(), rng.uniform()};
-      if (!bsdfSample(ctx, u, rng.uniform(), Transport::Importance, bs)) return;
-      if (settings.kind == MapKind::Caustic && !bs.delta) return;
+      if (!bsdfSample(ctx, u, rng.uniform(), Transport::Importance, bs)) return rays;
+      if (settings.kind == MapKind::Caustic && !bs.delta) return rays;
       allSpecular = allSpecular && bs.delta;
       // Russian roulette by the scattering's throughput: surviving photons
       // keep (on average) their power instead of dimming.
       float survive = std::min(1.0f, bs.weight.maxComponent());
-      if (!(survive > 0) || rng.uniform() >= survive) return;
+      if (!(survive > 0) || rng.uniform() >= survive) return rays;
       power = power * bs.weight / survive;
       origin = scene.spawnOrigin(hit.p, hit.n, bs.wi);
       dir = bs.wi;
     }
+    return rays;
   }
 
   // Traces batches [0, batches) in parallel into one store, batch order.
-  PhotonStore traceBatches(uint64_t batches, double energyScale, const Progress& progress, const char* stage) const {
+  PhotonStore traceBatches(uint64_t batches, double energyScale, const Progress& progress, const char* stage,
+                           uint64_t* raysOut = nullptr) const {
     std::vector<PhotonStore> parts(size_t(batches), PhotonStore(t0, t1));
+    std::atomic<uint64_t> rays{0};
     std::atomic<size_t> done{0};
     progress(stage, 0, size_t(batches));
     tbb::parallel_for(tbb::blocked_range<size_t>(0, size_t(batches), 1), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t b = r.begin(); b != r.end(); ++b) {
-        traceBatch(b, energyScale, parts[b]);
+        rays += traceBatch(b, energyScale, parts[b]);
         progress(stage, done.fetch_add(1) + 1, size_t(batches));
       }
     });
+    if (raysOut) *raysOut = rays.load();
     PhotonStore all(t0, t1);
     all.appendBatches(parts);
     return all;
@@ -162,7 +320,11 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   float t0, t1;
   photonTimeRange(scene, t0, t1);
   result.store = PhotonStore(t0, t1);
-  Tracer tracer{scene, settings, makeLightTable(scene), t0, t1, t1 - t0,
+  std::vector<Target> targets;
+  if (settings.kind == MapKind::Caustic) targets = specularTargets(scene);
+  Tracer tracer{scene, settings, targets,
+                makeLightTable(scene, settings.kind == MapKind::Caustic && settings.projection ? &targets : nullptr), t0,
+                t1, t1 - t0,
                 uint32_t(mix64(settings.seed ^ 0x7173ull))};
   if (settings.storedWanted == 0 || tracer.lights.empty()) return result;
   if (settings.kind == MapKind::Caustic && !sceneHasSpecular(scene)) return result;
@@ -197,7 +359,7 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   result.emitted = batches * kPathsPerBatch;
   // Q = flux * ts / n_e (method.md section 2).
   double energyScale = double(tracer.ts) / double(result.emitted);
-  result.store = tracer.traceBatches(batches, energyScale, progress, stage);
+  result.store = tracer.traceBatches(batches, energyScale, progress, stage, &result.rays);
   result.store.shrinkToFit();
   result.seconds = timer.seconds();
   return result;

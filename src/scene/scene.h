@@ -45,6 +45,8 @@ class Scene {
   // Closest hit along o + s d, s in (0, tFar), at normalised time time01.
   bool intersect(Vec3f o, Vec3f d, float tFar, float time01, Hit& hit) const;
   bool occluded(Vec3f o, Vec3f d, float tFar, float time01) const;
+  // The raw ray tracer (benchmarks compare our tracing against it).
+  const EmbreeScene& embree() const { return embree_; }
   // Origin for a ray leaving surface point p (normal n) in direction d:
   // pushed off the surface by a distance relative to the scene's scale.
   Vec3f spawnOrigin(Vec3f p, Vec3f n, Vec3f d) const;
