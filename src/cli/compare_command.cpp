@@ -92,7 +92,8 @@ ProfileSummary summarize(const image::RowProfile& p) {
   return s;
 }
 
-nlohmann::json channelsJson(const ImageMetrics& m, double image::ChannelMetrics::*field) {
+// ordered_json: keys print in the order written (r, g, b, overall), for people reading it.
+nlohmann::ordered_json channelsJson(const ImageMetrics& m, double image::ChannelMetrics::*field) {
   return {{"r", m.channel[0].*field}, {"g", m.channel[1].*field}, {"b", m.channel[2].*field}, {"overall", m.overall.*field}};
 }
 
@@ -136,7 +137,7 @@ void printText(const CompareArgs& a, const image::ImageRgb& test, const ImageMet
 
 void printJson(const CompareArgs& a, const image::ImageRgb& test, const ImageMetrics& m,
                const std::optional<image::RowProfile>& profile) {
-  using nlohmann::json;
+  using json = nlohmann::ordered_json;
   using CM = image::ChannelMetrics;
   json j;
   j["test"] = a.test;

@@ -222,7 +222,6 @@ Rgb Gatherer::twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf
   float invH = 1.0f / h;
   float norm = K2::integral((lo - u) * invH, (hi1 - u) * invH);
   float volume = kPi * r2 * (h * tq.binWidth) * norm;
-  float invR2 = 1.0f / r2;
   const uint16_t* dirs = s.directions();
   const uint32_t* energies = s.energies();
   // Compact the kept candidates without a branch (about half are kept, in
