@@ -61,18 +61,27 @@ float areaLightPdf(const Light& /*light*/, const AreaLightFrame& f, Vec3f p, Vec
   return dist2 / (cosL * f.area);
 }
 
+namespace {
+
+// Direction and distance from the shading point p to a point q on a light;
+// false when they coincide.
+bool aimAt(Vec3f p, Vec3f q, LightSample& out) {
+  Vec3f d = q - p;
+  float dist2 = lengthSquared(d);
+  if (!(dist2 > 0)) return false;
+  out.distance = std::sqrt(dist2);
+  out.wi = d / out.distance;
+  return true;
+}
+
+}  // namespace
+
 bool sampleLight(const Light& light, Vec3f p, float time01, Vec2f u, LightSample& out) {
   switch (light.type) {
     case Light::Type::Point:
     case Light::Type::Spot: {
       Affine3f m = light.motion.atNormalized(time01);
-      Vec3f lp = m.point(light.position);
-      Vec3f d = lp - p;
-      float dist2 = lengthSquared(d);
-      if (!(dist2 > 0)) return false;
-      float dist = std::sqrt(dist2);
-      out.wi = d / dist;
-      out.distance = dist;
+      if (!aimAt(p, m.point(light.position), out)) return false;
       out.pdf = 1.0f;
       Rgb i = light.intensity;
       if (light.type == Light::Type::Spot) {
@@ -81,7 +90,7 @@ bool sampleLight(const Light& light, Vec3f p, float time01, Vec2f u, LightSample
         if (f <= 0) return false;
         i = i * f;
       }
-      out.li = i / dist2;
+      out.li = i / (out.distance * out.distance);
       return true;
     }
     case Light::Type::Directional: {
@@ -95,12 +104,7 @@ bool sampleLight(const Light& light, Vec3f p, float time01, Vec2f u, LightSample
     case Light::Type::Area: {
       AreaLightFrame f = areaLightFrame(light, time01);
       Vec3f q = f.center + f.edgeX * (u.x - 0.5f) + f.edgeZ * (u.y - 0.5f);
-      Vec3f d = q - p;
-      float dist2 = lengthSquared(d);
-      if (!(dist2 > 0)) return false;
-      float dist = std::sqrt(dist2);
-      out.wi = d / dist;
-      out.distance = dist;
+      if (!aimAt(p, q, out)) return false;
       out.li = areaLightRadiance(light, f, -out.wi);
       if (out.li.isBlack()) return false;
       out.pdf = areaLightPdf(light, f, p, q);
