@@ -271,3 +271,69 @@ TEST_CASE("determinism: 1 and 2 threads give bit-identical images") {
   for (Rgb c : one.color) sum += c.average();
   CHECK(sum > 0);  // the scene is lit: the comparison is not between two black images
 }
+
+TEST_CASE("radiometry: a moving point light gives the time average of rho/pi * I cos / d^2") {
+  auto d = test::emptyScene(4, 4);
+  const float rho = 0.6f, I = 8.0f;
+  d.materials.push_back(test::diffuse(Rgb(rho)));
+  d.objects.push_back(test::quad({40, 40}, {0, 0, 0}, 0));
+  scene::LightDesc l;
+  l.type = scene::LightDesc::Type::Point;
+  l.position = {0, 1.5f, 0};
+  l.power = Rgb(4 * kPi * I);
+  l.motion = test::translation({-2, 0, 0}, {2, 0, 0});
+  d.lights.push_back(l);
+  auto s = Scene::build(d);
+  REQUIRE(s->hasMotion);
+  Vec3f q{0.5f, 0, 0.25f};
+  // Exact time average by a fine midpoint rule over the shutter.
+  double expected = 0;
+  const int nt = 4000;
+  for (int k = 0; k < nt; ++k) {
+    float t = (k + 0.5f) / nt;
+    Vec3f lp{-2 + 4 * t, 1.5f, 0};
+    Vec3f toL = lp - q;
+    double d2 = lengthSquared(toL);
+    expected += rho / kPi * I * (toL.y / std::sqrt(d2)) / d2;
+  }
+  expected /= nt;
+  // The path tracer at stratified times (one per path, as the renderer does).
+  PathTracer pt(*s, 4);
+  Rng rng(5);
+  Vec3f eye{0.5f, 2.0f, 1.0f};
+  const int n = 4096;
+  double sum = 0;
+  for (int i = 0; i < n; ++i) sum += pt.radiance(eye, normalize(q - eye), (i + rng.uniform()) / n, rng).r;
+  CHECK(sum / n == doctest::Approx(expected).epsilon(0.01));
+}
+
+TEST_CASE("radiometry: a moving area light (geometry and light sampling move together) matches the contour integral") {
+  auto d = test::emptyScene(4, 4);
+  const float rho = 0.7f;
+  d.materials.push_back(test::diffuse(Rgb(rho)));
+  d.objects.push_back(test::quad({40, 40}, {0, 0, 0}, 0));
+  scene::LightDesc l;
+  l.type = scene::LightDesc::Type::Area;
+  l.areaSize = {0.8f, 0.4f};
+  l.placement.translate = {0, 0.8f, 0};
+  l.power = Rgb(12.0f);
+  l.motion = test::translation({-0.6f, 0, 0}, {0.6f, 0, 0});
+  d.lights.push_back(l);
+  auto s = Scene::build(d);
+  float L = 12.0f / (kPi * 0.32f);
+  double expected = 0;
+  const int nt = 400;
+  for (int k = 0; k < nt; ++k) {
+    float cx = -0.6f + 1.2f * (k + 0.5f) / nt;
+    std::vector<Vec3f> c = {{cx - 0.4f, 0.8f, -0.2f}, {cx + 0.4f, 0.8f, -0.2f}, {cx + 0.4f, 0.8f, 0.2f}, {cx - 0.4f, 0.8f, 0.2f}};
+    expected += rho * kInvPi * polygonIrradiance(c, L);
+  }
+  expected /= nt;
+  PathTracer pt(*s, 4);
+  Rng rng(6);
+  Vec3f eye{0.8f, 0.4f, 1.5f};
+  const int n = 60000;
+  double sum = 0;
+  for (int i = 0; i < n; ++i) sum += pt.radiance(eye, normalize(Vec3f{0, 0, 0} - eye), (i + rng.uniform()) / n, rng).r;
+  CHECK(sum / n == doctest::Approx(expected).epsilon(0.01));
+}
