@@ -5,14 +5,15 @@
 # only what changed.
 #
 #   scripts/setup.sh render   # install + build + render scenes/glass-ball.json
-#   scripts/setup.sh test     # install + build + run all tests (CTest)
+#   scripts/setup.sh test     # install + build + a 20 s fuzzing run per target
+#                             # (scripts/fuzz.sh) + all tests (CTest)
 #   scripts/setup.sh build    # install + build only
 set -euo pipefail
 
 mode=${1:-render}
 case "$mode" in
   render|test|build) ;;
-  -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
+  -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
   *) echo "setup.sh: unknown mode '$mode' (expected render, test or build)" >&2; exit 2 ;;
 esac
 
@@ -22,7 +23,8 @@ cd "$root"
 packages=(g++ cmake make pkg-config
   libtbb-dev libembree-dev libxsimd-dev libopenexr-dev libpng-dev
   doctest-dev nlohmann-json3-dev libtinyobjloader-dev libcli11-dev
-  libnanoflann-dev libbenchmark-dev openimageio-tools)
+  libnanoflann-dev libbenchmark-dev openimageio-tools
+  clang libclang-rt-14-dev)  # libFuzzer + sanitizer runtimes (scripts/fuzz.sh); only recommended by clang
 
 missing=()
 for p in "${packages[@]}"; do
@@ -48,6 +50,10 @@ case "$mode" in
     build/tdpm render scenes/glass-ball.json -o glass-ball.exr
     ;;
   test)
-    cd build && ctest --output-on-failure -j "$jobs"
+    # A short bounded fuzzing run of the scene loader and the EXR reader
+    # (20 s each; about 2 min with its clang build on 2 cores), first, so
+    # that CTest's summary is the last thing printed.
+    scripts/fuzz.sh 20 && echo "setup.sh: fuzzing: no findings" || { echo "setup.sh: fuzzing FAILED (see above)" >&2; exit 1; }
+    (cd build && ctest --output-on-failure -j "$jobs")
     ;;
 esac

@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -67,6 +68,29 @@ void validateOutput(const std::string& out) {
     throw Error("--output: cannot write to directory '" + dir + "' (" + std::strerror(errno) + ")");
 }
 
+std::string formatMiB(uint64_t bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f MiB", double(bytes) / double(1 << 20));
+  return buf;
+}
+
+// --stats: one figure per line, "name: value", on stderr after the summary
+// (tests parse "peak resident memory: <bytes> bytes").
+void printStats(const RenderStats& st) {
+  auto u = [](uint64_t v) { return static_cast<unsigned long long>(v); };
+  std::fprintf(stderr, "tdpm: stats:\n");
+  std::fprintf(stderr, "  peak resident memory: %llu bytes (%s)\n", u(st.peakResidentBytes),
+               formatMiB(st.peakResidentBytes).c_str());
+  std::fprintf(stderr, "  bytes per photon: %.2f\n", st.bytesPerPhoton);
+  std::fprintf(stderr, "  caustic photons: %llu stored, %llu emitted\n", u(st.causticStored), u(st.causticEmitted));
+  std::fprintf(stderr, "  global photons: %llu stored, %llu emitted\n", u(st.globalStored), u(st.globalEmitted));
+  std::fprintf(stderr, "  photon pass: %.3f s\n", st.photonSeconds);
+  std::fprintf(stderr, "  render: %.3f s\n", std::max(0.0, st.seconds - st.photonSeconds));
+  std::fprintf(stderr, "  estimates: %llu time-dependent, %llu standard\n", u(st.timeEstimates),
+               u(st.standardEstimates));
+  std::fprintf(stderr, "  samples per pixel: %d-%d\n", st.minSpp, st.maxSpp);
+}
+
 std::string formatCount(uint64_t n) {
   char buf[32];
   if (n >= 1000000) std::snprintf(buf, sizeof buf, "%.1fM", double(n) / 1e6);
@@ -92,7 +116,7 @@ estimate::TimeKernel timeKernelFrom(const std::string& s) {
 }
 
 // Merges flags over the scene's settings over the renderer's defaults.
-RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc) {
+RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath) {
   RenderOptions o;
   o.method = pick(a.method, sc.method, o.method);
   o.spp = pick(a.spp, sc.spp, o.spp);
@@ -114,6 +138,9 @@ RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc)
   o.estimate.timeKernel = timeKernelFrom(pick(a.kernelTime, sc.kernelTime, std::string("uniform")));
   o.gatherRays = pick(a.gather, sc.gather, o.gatherRays);
   o.visualizeGlobal = a.globalDirect;
+  // For the memory-budget error: name what set each count.
+  if (!a.photons && sc.photons) o.causticPhotonsSource = "render.photons in " + sourcePath;
+  if (!a.globalPhotons && sc.globalPhotons) o.globalPhotonsSource = "render.global_photons in " + sourcePath;
   if (o.maxSpp < o.spp) throw Error("--max-spp (" + std::to_string(o.maxSpp) + ") is below --spp (" + std::to_string(o.spp) + ")");
   return o;
 }
@@ -140,6 +167,9 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
       ->check(CLI::Range(-64.0f, 64.0f));
   c->add_option("-t,--threads", a.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
   c->add_flag("-q,--quiet", a.quiet, "No progress bar and no summary");
+  c->add_flag("--stats", a.stats,
+              "After the summary, print peak resident memory, bytes per photon, photons stored and emitted per map, "
+              "photon-pass and render seconds, estimate counts and samples per pixel (also with --quiet)");
   const std::string photonGroup = "Photon methods (static, accumulation, standard, time)";
   c->add_option("--photons", a.photons, "Caustic photons to store (default 200000)")
       ->check(CLI::Range(int64_t(0), int64_t(1) << 31))->group(photonGroup);
@@ -180,7 +210,7 @@ int runRender(const RenderArgs& a) {
   validateOutput(output);
 
   scene::SceneDescription desc = scene::loadScene(a.scene);
-  RenderOptions opt = mergeOptions(a, desc.render);
+  RenderOptions opt = mergeOptions(a, desc.render, a.scene);
   float exposure = pick(a.exposure, desc.render.exposure, 0.0f);
   if (a.resolution) {
     desc.camera.width = width;
@@ -246,6 +276,7 @@ int runRender(const RenderArgs& a) {
                    stats.bytesPerPhoton, stats.photonSeconds, static_cast<unsigned long long>(stats.timeEstimates),
                    static_cast<unsigned long long>(stats.standardEstimates));
   }
+  if (a.stats) printStats(stats);
   return 0;
 }
 

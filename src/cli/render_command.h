@@ -27,6 +27,7 @@ struct RenderArgs {
   bool globalDirect = false;
   int threads = 0;  // 0: all cores
   bool quiet = false;
+  bool stats = false;  // --stats: memory, photon and timing figures after the summary
 };
 
 CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args);

@@ -99,10 +99,12 @@ void PhotonStore::appendBatches(const PhotonStore* batches, size_t count) {
     offset[b + 1] = offset[b] + batches[b].size();
   }
   size_t total = offset[count];
-  // Grow to exactly the total (no doubling slack), then copy each batch to
-  // its fixed offset: the result depends only on the batch order.
+  // Grow to exactly the total when a single append fills an empty store (no
+  // doubling slack); when appends come in chunks past a reservation, grow by
+  // half again so that each chunk does not reallocate. Then copy each batch
+  // to its fixed offset: the result depends only on the batch order.
   auto grow = [total](auto& v) {
-    if (v.capacity() < total) v.reserve(total);
+    if (v.capacity() < total) v.reserve(v.empty() ? total : std::max(total, v.capacity() + v.capacity() / 2));
     v.resize(total);
   };
   grow(x_);

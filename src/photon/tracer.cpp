@@ -23,6 +23,9 @@ namespace {
 
 constexpr uint32_t kPathsPerBatch = 1024;
 constexpr uint32_t kPilotBatches = 16;
+// Batches traced before they are appended to the result (see traceBatches):
+// enough work to keep every core busy, small next to a large map.
+constexpr uint64_t kBatchesPerChunk = 256;
 // A scene that stores (almost) nothing must not hang: the pilot gives up
 // after kMaxPilotPaths paths, and the emission is capped at
 // kMaxPathsPerPhoton paths per wanted photon (both reported as warnings).
@@ -281,22 +284,30 @@ struct Tracer {
     return rays;
   }
 
-  // Traces batches [0, batches) in parallel into one store, batch order.
+  // Traces batches [0, batches) in parallel into one store, in batch order.
+  // Batches are traced and appended a chunk at a time into a store reserved
+  // for the expected count, so memory peaks near the final store's 20 bytes
+  // per photon instead of holding every batch buffer and the result at once.
   PhotonStore traceBatches(uint64_t batches, double energyScale, const Progress& progress, const char* stage,
-                           uint64_t* raysOut = nullptr) const {
-    std::vector<PhotonStore> parts(size_t(batches), PhotonStore(t0, t1));
+                           size_t expected, uint64_t* raysOut = nullptr) const {
+    PhotonStore all(t0, t1);
+    all.reserve(expected);
     std::atomic<uint64_t> rays{0};
     std::atomic<size_t> done{0};
     progress(stage, 0, size_t(batches));
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, size_t(batches), 1), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t b = r.begin(); b != r.end(); ++b) {
-        rays += traceBatch(b, energyScale, parts[b]);
-        progress(stage, done.fetch_add(1) + 1, size_t(batches));
-      }
-    });
+    std::vector<PhotonStore> parts;
+    for (uint64_t first = 0; first < batches; first += kBatchesPerChunk) {
+      size_t count = size_t(std::min<uint64_t>(kBatchesPerChunk, batches - first));
+      parts.assign(count, PhotonStore(t0, t1));
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t b = r.begin(); b != r.end(); ++b) {
+          rays += traceBatch(first + b, energyScale, parts[b]);
+          progress(stage, done.fetch_add(1) + 1, size_t(batches));
+        }
+      });
+      all.appendBatches(parts);
+    }
     if (raysOut) *raysOut = rays.load();
-    PhotonStore all(t0, t1);
-    all.appendBatches(parts);
     return all;
   }
 };
@@ -335,7 +346,7 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   uint64_t pilotBatches = kPilotBatches;
   size_t stored = 0;
   for (;;) {
-    PhotonStore pilot = tracer.traceBatches(pilotBatches, 1.0, Progress{}, stage);
+    PhotonStore pilot = tracer.traceBatches(pilotBatches, 1.0, Progress{}, stage, 0);
     stored = pilot.size();
     uint64_t paths = pilotBatches * kPathsPerBatch;
     if (stored > 0 || paths >= kMaxPilotPaths) break;
@@ -359,7 +370,10 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   result.emitted = batches * kPathsPerBatch;
   // Q = flux * ts / n_e (method.md section 2).
   double energyScale = double(tracer.ts) / double(result.emitted);
-  result.store = tracer.traceBatches(batches, energyScale, progress, stage, &result.rays);
+  // The final count is Poisson-like around the wanted one: reserve a few
+  // standard deviations more so the store rarely needs to grow.
+  size_t expected = settings.storedWanted + size_t(4.0 * std::sqrt(double(settings.storedWanted))) + 1024;
+  result.store = tracer.traceBatches(batches, energyScale, progress, stage, expected, &result.rays);
   result.store.shrinkToFit();
   result.seconds = timer.seconds();
   return result;

@@ -3,13 +3,17 @@
 #include "render/renderer.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <vector>
 
 #include "core/error.h"
+#include "core/memory.h"
 #include "core/rng.h"
 #include "core/timer.h"
+#include "photon/tracer.h"
 #include "render/path_tracer.h"
 #include "render/photon_integrator.h"
 #include "render/photon_map.h"
@@ -24,21 +28,29 @@ const char* const kMethods[] = {"pathtrace", "static", "accumulation", "standard
 
 // Streams a pixel's samples into a mean and the variance of that mean
 // (Welford's update: stable in one pass), plus luminance statistics for
-// the adaptive stopping rule.
+// the adaptive stopping rule. The sums of squares are doubles: radiance
+// above ~1e19 is a valid float, its square is not (a 1e30 W light gave an
+// infinite variance layer); the variance is saturated to FLT_MAX on output.
 struct PixelAccumulator {
-  Rgb mean{0.0f}, m2{0.0f};
+  Rgb mean{0.0f};
+  double m2[3] = {0, 0, 0};
   double lumMean = 0, lumM2 = 0;
   int n = 0;
   void add(Rgb v) {
     ++n;
     Rgb d = v - mean;
     mean += d / float(n);
-    m2 += d * (v - mean);
+    for (int c = 0; c < 3; ++c) m2[c] += double(d[c]) * double(v[c] - mean[c]);
     double l = v.luminance(), dl = l - lumMean;
     lumMean += dl / n;
     lumM2 += dl * (l - lumMean);
   }
-  Rgb varianceOfMean() const { return n > 1 ? m2 / (float(n) * float(n - 1)) : Rgb(0.0f); }
+  Rgb varianceOfMean() const {
+    if (n < 2) return Rgb(0.0f);
+    Rgb v;
+    for (int c = 0; c < 3; ++c) v[c] = float(std::min(m2[c] / (double(n) * double(n - 1)), double(FLT_MAX)));
+    return v;
+  }
   // Contrast: the standard error of the mean luminance relative to the mean
   // (plus a floor, so near-black pixels are judged on absolute error).
   double contrast() const {
@@ -48,6 +60,16 @@ struct PixelAccumulator {
   }
   static constexpr double kContrastFloor = 0.02;
 };
+
+// NaN -> 0, +-Inf -> +-FLT_MAX, per channel.
+Rgb saturateSample(Rgb L) {
+  for (int c = 0; c < 3; ++c) {
+    float& v = L[c];
+    if (std::isnan(v)) v = 0.0f;
+    else if (std::isinf(v)) v = v > 0 ? FLT_MAX : -FLT_MAX;
+  }
+  return L;
+}
 
 struct SamplingPlan {
   int batch = 16, maxSpp = 16;
@@ -84,8 +106,10 @@ void renderPixels(const Scene& scene, const Integrator& integrator, const Sampli
             Vec3f o, d;
             cam.generateRay({float(x) + cs.pixelOffset.x, float(y) + cs.pixelOffset.y}, cs.time01, o, d);
             Rgb L = integrator.radiance(o, d, cs.time01, rng, s.state);
-            // A NaN/Inf sample is a bug upstream; never let it reach the film.
-            if (!isFinite(L)) L = Rgb(0.0f);
+            // A NaN sample is a bug upstream; never let it reach the film. An
+            // infinite one is a finite scene overflowing float (a tiny
+            // emitter of huge power): it saturates, as a sensor would.
+            if (!isFinite(L)) L = saturateSample(L);
             acc.add(L);
           }
           if (acc.n + plan.batch > plan.maxSpp || acc.contrast() <= plan.contrast) break;
@@ -151,6 +175,33 @@ PhotonIntegratorSettings integratorSettings(const Scene& scene, const RenderOpti
   return s;
 }
 
+// The photon maps the options will really trace (a caustic map needs a
+// specular surface, any map needs a light; accumulation traces 1/N per
+// frame, one frame's maps at a time), checked against MemAvailable before
+// the first photon is traced.
+void checkPhotonBudget(const Scene& scene, const RenderOptions& opt) {
+  if (opt.method == "pathtrace" || scene.lights.empty()) return;
+  size_t caustic = photon::sceneHasSpecular(scene) ? opt.causticPhotons : 0;
+  size_t global = opt.visualizeGlobal || opt.gatherRays > 0 ? opt.globalPhotons : 0;
+  bool spaceTime = false;
+  if (opt.method == "accumulation") {
+    size_t frames = size_t(scene.hasMotion ? std::max(1, opt.frames) : 1);
+    caustic = (caustic + frames - 1) / frames;
+    global = (global + frames - 1) / frames;
+  } else {
+    spaceTime = opt.spaceTime4D && opt.method != "static" && scene.hasMotion;
+  }
+  checkPhotonMemory(caustic, global, spaceTime, opt.maxDepth, availableMemoryBytes(), opt.causticPhotonsSource,
+                    opt.globalPhotonsSource);
+}
+
+std::string formatBytes(uint64_t b) {
+  char buf[64];
+  if (b >= (uint64_t(1) << 30)) std::snprintf(buf, sizeof buf, "%.2f GiB", double(b) / double(uint64_t(1) << 30));
+  else std::snprintf(buf, sizeof buf, "%.1f MiB", double(b) / double(uint64_t(1) << 20));
+  return std::to_string(b) + " bytes (" + buf + ")";
+}
+
 void finishStats(const Film& film, RenderStats& st) {
   st.cameraSamples = 0;
   st.minSpp = film.sampleCount.empty() ? 0 : int(film.sampleCount[0]);
@@ -164,6 +215,61 @@ void finishStats(const Film& film, RenderStats& st) {
 
 }  // namespace
 
+// Bytes per stored photon, as photon/ holds them (docs/photon-map.md):
+constexpr uint64_t kStoreBytes = 20;        // the store; the kd-tree adds nothing
+// Tracing appends chunks of batches to a store reserved for the expected
+// count (photon/tracer.cpp), then shrinks it to fit: one copy of the store.
+constexpr uint64_t kShrinkBytes = 20;
+// A chunk's per-batch buffers: up to 2x the photons they hold from vector
+// growth, for at most kChunkPaths paths (kBatchesPerChunk x kPathsPerBatch).
+constexpr uint64_t kChunkBytes = 2 * 20;
+constexpr uint64_t kChunkPaths = 256 * 1024;
+constexpr uint64_t kBuild3Bytes = 16 + 5;   // kd-tree builder: 3D keys + index, then permutation + axis
+constexpr uint64_t kBuild4Bytes = 20 + 5;   // 4D keys + index, permutation + axis
+constexpr uint64_t kPilotPaths = 16 * 1024; // photon/tracer.cpp: 16 pilot batches of 1024 paths
+
+uint64_t photonMemoryBytes(size_t caustic, size_t global, bool spaceTime4D, int maxDepth) {
+  // One map: what it keeps, and the most it holds at once while it is made.
+  auto kept = [&](uint64_t n) { return n * kStoreBytes * (spaceTime4D ? 2 : 1); };
+  auto peak = [&](uint64_t n, uint64_t storedPerPilotPath) {
+    if (n == 0) return uint64_t(0);
+    uint64_t chunk = std::min<uint64_t>(n, kChunkPaths * storedPerPilotPath) * kChunkBytes;
+    uint64_t tracing = n * (kStoreBytes + kShrinkBytes) + chunk;
+    // 3D: store + builder. 4D: the 3D copy is kept while the 4D tree is built.
+    uint64_t building = spaceTime4D ? n * (2 * kStoreBytes + kBuild4Bytes) : n * (kStoreBytes + kBuild3Bytes);
+    uint64_t pilot = kPilotPaths * storedPerPilotPath * (kStoreBytes + kChunkBytes);
+    return std::max({tracing, building, pilot});
+  };
+  // A caustic path stores at most one photon; a global path one per bounce.
+  uint64_t causticPeak = peak(caustic, 1);
+  uint64_t globalPeak = peak(global, uint64_t(std::max(1, maxDepth)) + 1);
+  return std::max(causticPeak, kept(caustic) + globalPeak);
+}
+
+uint64_t memoryMarginBytes(uint64_t available) { return (uint64_t(256) << 20) + available / 16; }
+
+void checkPhotonMemory(size_t caustic, size_t global, bool spaceTime4D, int maxDepth, uint64_t available,
+                       const std::string& causticName, const std::string& globalName) {
+  if (available == 0) return;  // unknown: better to try than to refuse
+  uint64_t margin = memoryMarginBytes(available);
+  uint64_t usable = available > margin ? available - margin : 0;
+  uint64_t needed = photonMemoryBytes(caustic, global, spaceTime4D, maxDepth);
+  if (needed <= usable) return;
+  // Blame the count that alone does not fit, else both together.
+  std::string what;
+  if (photonMemoryBytes(caustic, 0, spaceTime4D, maxDepth) > usable)
+    what = causticName + " asks for " + std::to_string(caustic) + " caustic photons";
+  else if (photonMemoryBytes(0, global, spaceTime4D, maxDepth) > usable)
+    what = globalName + " asks for " + std::to_string(global) + " global photons";
+  else
+    what = causticName + " and " + globalName + " ask for " + std::to_string(caustic) + " caustic and " +
+           std::to_string(global) + " global photons";
+  throw Error(what + (spaceTime4D ? " with --search 4d" : "") + ", which need about " + formatBytes(needed) +
+              " while tracing and building the kd-trees, but only " + formatBytes(usable) +
+              " of memory is available (MemAvailable " + formatBytes(available) + " less a margin of " +
+              formatBytes(margin) + "); lower the photon counts");
+}
+
 const char* const* renderMethods() { return kMethods; }
 
 bool isRenderMethod(const std::string& name) {
@@ -175,6 +281,8 @@ bool isRenderMethod(const std::string& name) {
 Film render(const Scene& scene, const RenderOptions& opt, const Progress& progress, RenderStats& st) {
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
   if (!isRenderMethod(opt.method)) throw Error("unknown method '" + opt.method + "'");
+  // Before any work: an impossible photon budget is an error, not an OOM kill.
+  checkPhotonBudget(scene, opt);
   Timer timer;
   st = RenderStats{};
   Film film(scene.camera.width(), scene.camera.height());
@@ -218,10 +326,11 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
       }
     }
     float inv = 1.0f / float(frames);
+    // Frames near FLT_MAX can sum to infinity: saturate, as each frame did.
     for (size_t i = 0; i < film.color.size(); ++i) {
-      film.color[i] = sum.color[i] * inv;
+      film.color[i] = saturateSample(sum.color[i] * inv);
       film.sampleCount[i] = sum.sampleCount[i];
-      film.varianceOfMean[i] = sum.varianceOfMean[i] * (inv * inv);  // var of an average of independent frames
+      film.varianceOfMean[i] = saturateSample(sum.varianceOfMean[i] * (inv * inv));  // var of an average of independent frames
     }
   } else {
     // static: photons at shutter open; standard and time: spread in time.
@@ -236,6 +345,7 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
   }
   finishStats(film, st);
   st.seconds = timer.seconds();
+  st.peakResidentBytes = peakResidentBytes();
   return film;
 }
 

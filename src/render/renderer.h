@@ -36,6 +36,10 @@ struct RenderOptions {
   float maxRadiusFraction = 0.02f; // max radius when estimate.maxRadius is not set: of the scene's diagonal
   int gatherRays = 1;
   bool visualizeGlobal = false;
+  // How the user set the two photon counts, for the memory-budget error:
+  // the flag, or the scene key and file (cli/render_command.cpp sets these).
+  std::string causticPhotonsSource = "--photons";
+  std::string globalPhotonsSource = "--global-photons";
 };
 
 struct RenderStats {
@@ -47,6 +51,7 @@ struct RenderStats {
   double bytesPerPhoton = 0;
   uint64_t standardEstimates = 0, timeEstimates = 0;
   int minSpp = 0, maxSpp = 0;  // over pixels
+  uint64_t peakResidentBytes = 0;  // of the whole process, at the end of render() (core/memory.h)
   std::vector<std::string> warnings;  // for the user: empty photon maps and the like
 };
 
@@ -54,6 +59,27 @@ struct RenderStats {
 const char* const* renderMethods();
 bool isRenderMethod(const std::string& name);
 
+// Throws tdpm::Error, before any photon is traced, when the photon maps
+// the options ask for cannot fit in the machine's available memory
+// (checkPhotonMemory below with MemAvailable).
 Film render(const Scene& scene, const RenderOptions& options, const Progress& progress, RenderStats& stats);
+
+// ---- photon memory budget ----
+// Peak bytes the photon passes hold for maps of `caustic` and `global`
+// stored photons (the global map is traced while the caustic map is held):
+// 20 bytes per stored photon, a second 3D-ordered copy for the 4D search,
+// and the transients: the per-batch buffers while tracing (up to 2x their
+// size from vector growth, alive until they are concatenated) or the
+// kd-tree builder's keys and permutation, plus the pilot run.
+uint64_t photonMemoryBytes(size_t caustic, size_t global, bool spaceTime4D, int maxDepth);
+// Memory kept back from MemAvailable for everything that is not photons
+// (scene, film, threads, other processes' growth).
+uint64_t memoryMarginBytes(uint64_t available);
+// Throws tdpm::Error naming `causticName` and/or `globalName` (the flag or
+// scene key that set each count), the bytes needed and the bytes available
+// when photonMemoryBytes(...) > available - margin. available == 0 means
+// unknown (no /proc): no check.
+void checkPhotonMemory(size_t caustic, size_t global, bool spaceTime4D, int maxDepth, uint64_t available,
+                       const std::string& causticName, const std::string& globalName);
 
 }  // namespace tdpm

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Short bounded libFuzzer run of the scene loader and the EXR reader
+# (fuzz/): configures and builds build-fuzz with clang++ (TDPM_FUZZ=ON,
+# ASan + UBSan), then runs each target for SECONDS on a fresh copy of its
+# seed corpus. Fails (exit 1) on any crash, sanitizer report, leak, timeout
+# or out-of-memory; the reproducer is left in build-fuzz/findings/<target>/.
+#
+#   scripts/fuzz.sh [SECONDS]     # default 25 per target
+#
+# Seeds: scenes/*.json and tests/data/*.json for fuzz_scene; fuzz/corpus/exr/
+# (small EXRs written by tdpm) for fuzz_exr. The corpus copies grown by a run
+# are thrown away: the seeds in git stay small and reviewed.
+set -euo pipefail
+
+seconds=${1:-25}
+case "$seconds" in ''|*[!0-9]*) echo "fuzz.sh: SECONDS must be a whole number, got '$seconds'" >&2; exit 2 ;; esac
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ not found (scripts/setup.sh installs clang and libclang-rt-14-dev)" >&2; exit 1; }
+
+jobs=$(nproc 2>/dev/null || echo 2)
+start=$(date +%s)
+cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ -DTDPM_FUZZ=ON \
+  -DTDPM_BUILD_TESTS=OFF -DTDPM_BUILD_BENCH=OFF >/dev/null
+cmake --build build-fuzz -j "$jobs" --target fuzz_scene fuzz_exr
+echo "fuzz.sh: build took $(( $(date +%s) - start )) s"
+
+work=build-fuzz/run
+rm -rf "$work"
+mkdir -p "$work/scene" "$work/exr"
+cp scenes/*.json tests/data/*.json "$work/scene/" 2>/dev/null || true
+cp fuzz/corpus/exr/*.exr "$work/exr/"
+
+status=0
+for target in scene exr; do
+  findings=build-fuzz/findings/$target
+  mkdir -p "$findings"
+  log=build-fuzz/fuzz_$target.log
+  # -timeout: one input taking over 10 s is a hang; -rss_limit_mb: a
+  # runaway allocation is a finding too. ASan's leak check stays on.
+  if build-fuzz/fuzz/fuzz_$target "$work/$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+       -artifact_prefix="$findings/" -print_final_stats=1 >"$log" 2>&1; then
+    runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')
+    cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*' || echo '?')
+    echo "fuzz.sh: fuzz_$target: ok, $runs inputs in ${seconds} s ($(( ${runs:-0} / seconds )) per second), coverage $cov edges, corpus $(ls "$work/$target" | wc -l) files"
+  else
+    status=1
+    echo "fuzz.sh: fuzz_$target: FAILED; reproducer in $findings/, log $log:" >&2
+    grep -E 'ERROR|SUMMARY|==[0-9]+==|Test unit written' "$log" | head -20 >&2 || tail -30 "$log" >&2
+  fi
+done
+exit $status
