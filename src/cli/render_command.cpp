@@ -175,7 +175,7 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
       ->check(CLI::Range(int64_t(0), int64_t(1) << 31))->group(photonGroup);
   c->add_option("--global-photons", a.globalPhotons, "Global photons to store (default 50000)")
       ->check(CLI::Range(int64_t(0), int64_t(1) << 31))->group(photonGroup);
-  c->add_option("--frames", a.frames, "accumulation: in-between frames, each with 1/N of the photons (default 8)")
+  c->add_option("--frames", a.frames, "accumulation: in-between frames, each with 1/N of the photons and of the samples (default 8)")
       ->check(CLI::Range(1, 4096))->group(photonGroup);
   c->add_option("--search", a.search, "time: twopass (space, then time) or 4d (space-time kd-tree) (default twopass)")
       ->check(CLI::IsMember({"twopass", "4d"}))->group(photonGroup);
