@@ -18,7 +18,7 @@ double totalEnergy(const photon::PhotonStore& s) {
   return e;
 }
 
-scene::SceneDescription glassOverFloor(scene::LightDesc light) {
+scene::SceneDescription glassOverFloor(std::vector<scene::LightDesc> lights) {
   auto d = test::emptyScene(8, 8);
   d.camera.shutterClose = 2.0f;  // ts = 2 s: energies scale with it
   d.materials.push_back(test::diffuse(Rgb(0.5f)));
@@ -31,7 +31,7 @@ scene::SceneDescription glassOverFloor(scene::LightDesc light) {
   ball.motion.poses.resize(2);
   ball.motion.poses[1].translate = {0.5f, 0, 0};
   d.objects.push_back(ball);
-  d.lights.push_back(light);
+  d.lights = std::move(lights);
   return d;
 }
 
@@ -83,7 +83,7 @@ TEST_CASE("photon tracing: projection maps keep the caustic energy and waste few
   // aims most of its power at the ball, the others waste most paths.
   const int minGain[] = {5, 2, 20, 2};
   for (int i = 0; i < 4; ++i) {
-    auto d = glassOverFloor(lights[size_t(i)]);
+    auto d = glassOverFloor({lights[size_t(i)]});
     auto s = Scene::build(d);
     photon::TraceSettings ts;
     ts.kind = photon::MapKind::Caustic;
@@ -134,4 +134,34 @@ TEST_CASE("photon tracing: path times are stratified over the shutter and stored
   for (int b : bins) CHECK(b == expected);
   CHECK(r.store.t0() == 1.0f);
   CHECK(r.store.t1() == 3.0f);
+}
+
+TEST_CASE("photon tracing: several lights share the caustic map and keep its energy") {
+  // A weak narrow spot and a strong area light both reach the ball: the
+  // caustic map's light choice (half by power toward the targets, half
+  // shared) must leave the total energy unchanged.
+  scene::LightDesc spot;
+  spot.type = scene::LightDesc::Type::Spot;
+  spot.position = {0.3f, 3, 0};
+  spot.direction = {0, -1, 0};
+  spot.coneAngle = 2;
+  spot.falloffStart = 1.5f;
+  spot.power = Rgb(2.0f);
+  scene::LightDesc area;
+  area.type = scene::LightDesc::Type::Area;
+  area.areaSize = {1, 1};
+  area.placement.translate = {-1, 3, 0};
+  area.power = Rgb(300.0f);
+  auto d = glassOverFloor({spot, area});
+  auto s = Scene::build(d);
+  photon::TraceSettings ts;
+  ts.kind = photon::MapKind::Caustic;
+  ts.storedWanted = 60000;
+  ts.seed = 4;
+  photon::TraceResult with = photon::tracePhotons(*s, ts, Progress{});
+  ts.projection = false;
+  photon::TraceResult without = photon::tracePhotons(*s, ts, Progress{});
+  double a = totalEnergy(with.store), b = totalEnergy(without.store);
+  INFO("with projection " << a << " J, without " << b << " J");
+  CHECK(a == doctest::Approx(b).epsilon(0.03));
 }

@@ -243,6 +243,7 @@ int runRender(const RenderArgs& a) {
                   {"tdpm/method", opt.method},
                   {"tdpm/spp", std::to_string(opt.spp)},
                   {"tdpm/max_spp", std::to_string(opt.maxSpp)},
+                  {"tdpm/spp_taken", std::to_string(stats.minSpp) + "-" + std::to_string(stats.maxSpp)},
                   {"tdpm/seed", std::to_string(opt.seed)},
                   {"tdpm/max_depth", std::to_string(opt.maxDepth)},
                   {"tdpm/render_seconds", seconds}};

@@ -185,8 +185,20 @@ double powerTowardTargets(const Light& light, const std::vector<Target>& targets
       double cap = light.type == Light::Type::Spot ? 2.0 * kPi * (1.0 - light.cosTotal) : 4.0 * kPi;
       return light.intensity.average() * std::min(sum, cap);
     }
-    case Light::Type::Area:
-      return light.power.average();
+    case Light::Type::Area: {
+      // Radiance x area x the projected solid angle of the targets, seen
+      // from the light's centre (small targets).
+      AreaLightFrame fr = areaLightFrame(light, 0.5f);
+      if (!(fr.area > 0)) return 0;
+      for (const Target& t : targets) {
+        Vec3f to = t.centre - fr.center;
+        float dist = length(to);
+        float cosL = dist > 0 ? dot(to / dist, fr.normal) : 1.0f;
+        float cone = 2.0f * kPi * (1.0f - coneCos(t, fr.center));
+        sum += double(cone) * std::max(0.0f, std::min(1.0f, cosL + t.radius / std::max(dist, 1e-6f)));
+      }
+      return (light.power / (kPi * fr.area)).average() * fr.area * std::min(sum, double(kPi));
+    }
     case Light::Type::Directional:
       for (const Target& t : targets) sum += kPi * double(t.radius) * t.radius;
       return light.power.average() * sum;
@@ -207,11 +219,19 @@ LightTable makeLightTable(const Scene& scene, const std::vector<Target>* targets
     total += p;
   }
   if (!(total > 0)) return t;
+  // Caustic map: half the photons by power toward the targets, half shared
+  // equally among the lights that reach them (a defensive mixture). A faint
+  // but concentrated source (a 14 W laser beside a sun of kilowatts) still
+  // gets photons to resolve its caustic; energies stay exact because each
+  // photon's flux is divided by its light's probability.
+  size_t reaching = 0;
+  for (double p : w) reaching += p > 0;
   double acc = 0;
   for (double p : w) {
-    acc += p;
-    t.cdf.push_back(float(acc / total));
-    t.pdf.push_back(float(p / total));
+    double prob = targets ? 0.5 * p / total + (p > 0 ? 0.5 / double(reaching) : 0.0) : p / total;
+    acc += prob;
+    t.cdf.push_back(float(acc));
+    t.pdf.push_back(float(prob));
   }
   t.cdf.back() = 1.0f;
   return t;

@@ -169,6 +169,7 @@ PhotonIntegratorSettings integratorSettings(const Scene& scene, const RenderOpti
   s.spaceTime4D = opt.spaceTime4D;
   s.estimate = opt.estimate;
   s.estimate.maxRadius = defaultMaxRadius(scene, opt);
+  if (!std::isfinite(s.estimate.maxTimeDistance)) s.estimate.maxTimeDistance = opt.maxDtFraction * scene.shutter.length();
   s.gatherRays = opt.gatherRays;
   s.visualizeGlobal = opt.visualizeGlobal;
   s.maxDepth = opt.maxDepth;

@@ -34,6 +34,11 @@ struct RenderOptions {
   float kappa = 1.0f;              // 4D metric weight
   estimate::Options estimate;      // k, ks, fraction, max radius / dt, kernels
   float maxRadiusFraction = 0.02f; // max radius when estimate.maxRadius is not set: of the scene's diagonal
+  // Largest time distance kept by the two-pass search when
+  // estimate.maxTimeDistance is not set, as a fraction of the shutter: the
+  // nearest-in-time estimate decays only as k f / (2 dt) away from a moving
+  // caustic, and those tails smear a sharp spot (Delta t_max of method.md).
+  float maxDtFraction = 0.1f;
   int gatherRays = 1;
   bool visualizeGlobal = false;
   // How the user set the two photon counts, for the memory-budget error:
