@@ -365,14 +365,18 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   // until something is stored or the cap says the scene stores nothing.
   uint64_t pilotBatches = kPilotBatches;
   size_t stored = 0;
+  uint64_t pilotRays = 0;
   for (;;) {
-    PhotonStore pilot = tracer.traceBatches(pilotBatches, 1.0, Progress{}, stage, 0);
+    uint64_t rays = 0;
+    PhotonStore pilot = tracer.traceBatches(pilotBatches, 1.0, Progress{}, stage, 0, &rays);
+    pilotRays += rays;
     stored = pilot.size();
     uint64_t paths = pilotBatches * kPathsPerBatch;
     if (stored > 0 || paths >= kMaxPilotPaths) break;
     pilotBatches *= 8;
   }
   if (stored == 0) {
+    result.rays = pilotRays;
     result.warning = std::string(stage) + ": none of " + std::to_string(pilotBatches * kPathsPerBatch) +
                      " paths stored a photon; the map is empty";
     return result;
@@ -394,6 +398,7 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   // standard deviations more so the store rarely needs to grow.
   size_t expected = settings.storedWanted + size_t(4.0 * std::sqrt(double(settings.storedWanted))) + 1024;
   result.store = tracer.traceBatches(batches, energyScale, progress, stage, expected, &result.rays);
+  result.rays += pilotRays;
   result.store.shrinkToFit();
   result.seconds = timer.seconds();
   return result;

@@ -36,7 +36,7 @@ struct TraceSettings {
 struct TraceResult {
   PhotonStore store;
   uint64_t emitted = 0;  // n_e: paths emitted from all lights
-  uint64_t rays = 0;     // rays cast by the final run (for throughput figures)
+  uint64_t rays = 0;     // rays cast, pilot included (throughput of the whole pass)
   double seconds = 0;
   std::string warning;   // set when the map is empty or smaller than wanted
 };

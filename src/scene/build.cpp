@@ -148,6 +148,13 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
       uint32_t id = s.embree_.addTriangles(stepVertices(o.motion, mesh.vertices), mesh.indices);
       TDPM_ASSERT(id + 1 == s.geometryOwner_.size(), "geometry ids out of order");
     }
+    if (!o.motion.moving()) {
+      const Affine3f& m = o.motion.step(0);
+      o.worldCentre = m.point({0, 0, 0});
+      o.inversePlacement = m.inverse();
+      o.worldNormals.reserve(o.faceNormals.size());
+      for (Vec3f n : o.faceNormals) o.worldNormals.push_back(normalize(m.normal(n)));
+    }
     o.sweptBounds = o.motion.sweptBounds(o.objectBounds);
     s.bounds.extend(o.sweptBounds);
     if (o.motion.moving()) {

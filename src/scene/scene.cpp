@@ -33,13 +33,24 @@ bool Scene::intersect(Vec3f o, Vec3f d, float tFar, float time01, Hit& hit) cons
   hit.light = -1;
   hit.object = uint32_t(owner);
   const SceneObject& obj = objects[size_t(owner)];
+  if (!obj.motion.moving()) {
+    // Static: world-space normals and the inverse placement were made once.
+    hit.n = obj.kind == SceneObject::Kind::Sphere ? normalize(hit.p - obj.worldCentre) : obj.worldNormals[raw.primitiveId];
+    hit.localP = obj.inversePlacement.point(hit.p);
+    return true;
+  }
   Affine3f m = obj.motion.atNormalized(time01);
+  Affine3f inv = m.inverse();  // once: for the object-space point and the normal
   if (obj.kind == SceneObject::Kind::Sphere) {
     hit.n = normalize(hit.p - m.point({0, 0, 0}));
   } else {
-    hit.n = normalize(m.normal(obj.faceNormals[raw.primitiveId]));
+    // Normals transform by the inverse transpose.
+    Vec3f n = obj.faceNormals[raw.primitiveId];
+    hit.n = normalize(Vec3f{inv.m[0][0] * n.x + inv.m[1][0] * n.y + inv.m[2][0] * n.z,
+                            inv.m[0][1] * n.x + inv.m[1][1] * n.y + inv.m[2][1] * n.z,
+                            inv.m[0][2] * n.x + inv.m[1][2] * n.y + inv.m[2][2] * n.z});
   }
-  hit.localP = m.inverse().point(hit.p);
+  hit.localP = inv.point(hit.p);
   return true;
 }
 

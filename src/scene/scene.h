@@ -26,6 +26,10 @@ struct SceneObject {
   Bounds3f objectBounds;            // object space
   Bounds3f sweptBounds;             // world, over the whole shutter
   std::vector<Vec3f> faceNormals;   // triangles: object-space unit normals
+  // Static objects only (precomputed, so a hit costs no matrix inverse):
+  std::vector<Vec3f> worldNormals;  // triangles: world-space unit normals
+  Vec3f worldCentre;                // sphere centre
+  Affine3f inversePlacement;
 };
 
 struct Hit {
