@@ -50,6 +50,20 @@ float polygonIrradiance(const std::vector<Vec3f>& verts, float L) {
   return 0.5f * L * std::fabs(sum);
 }
 
+// A diffuse floor of albedo rho under one rectangular area light.
+scene::SceneDescription floorUnderAreaLight(float rho, Vec2f size, Vec3f centre, float power) {
+  auto d = test::emptyScene(4, 4);
+  d.materials.push_back(test::diffuse(Rgb(rho)));
+  d.objects.push_back(test::quad({40, 40}, {0, 0, 0}, 0));
+  scene::LightDesc l;
+  l.type = scene::LightDesc::Type::Area;
+  l.areaSize = size;
+  l.placement.translate = centre;
+  l.power = Rgb(power);
+  d.lights.push_back(l);
+  return d;
+}
+
 }  // namespace
 
 TEST_CASE("radiometry: diffuse plane under a point light is rho/pi * I cos / d^2") {
@@ -98,17 +112,8 @@ TEST_CASE("radiometry: spot light is the point-light value inside the cone and z
 }
 
 TEST_CASE("radiometry: rectangular area light (NEE + MIS) matches Lambert's contour integral") {
-  auto d = test::emptyScene(4, 4);
   const float rho = 0.7f;
-  d.materials.push_back(test::diffuse(Rgb(rho)));
-  d.objects.push_back(test::quad({40, 40}, {0, 0, 0}, 0));
-  scene::LightDesc l;
-  l.type = scene::LightDesc::Type::Area;
-  l.areaSize = {1.0f, 0.5f};
-  l.placement.translate = {0.4f, 1.0f, 0.2f};
-  l.power = Rgb(20.0f);
-  d.lights.push_back(l);
-  auto s = Scene::build(d);
+  auto s = Scene::build(floorUnderAreaLight(rho, {1.0f, 0.5f}, {0.4f, 1.0f, 0.2f}, 20.0f));
   float L = 20.0f / (kPi * 0.5f);  // radiance = power / (pi * area)
   std::vector<Vec3f> corners = {{-0.1f, 1, -0.05f}, {0.9f, 1, -0.05f}, {0.9f, 1, 0.45f}, {-0.1f, 1, 0.45f}};
   float E = polygonIrradiance(corners, L);
@@ -308,17 +313,9 @@ TEST_CASE("radiometry: a moving point light gives the time average of rho/pi * I
 }
 
 TEST_CASE("radiometry: a moving area light (geometry and light sampling move together) matches the contour integral") {
-  auto d = test::emptyScene(4, 4);
   const float rho = 0.7f;
-  d.materials.push_back(test::diffuse(Rgb(rho)));
-  d.objects.push_back(test::quad({40, 40}, {0, 0, 0}, 0));
-  scene::LightDesc l;
-  l.type = scene::LightDesc::Type::Area;
-  l.areaSize = {0.8f, 0.4f};
-  l.placement.translate = {0, 0.8f, 0};
-  l.power = Rgb(12.0f);
-  l.motion = test::translation({-0.6f, 0, 0}, {0.6f, 0, 0});
-  d.lights.push_back(l);
+  auto d = floorUnderAreaLight(rho, {0.8f, 0.4f}, {0, 0.8f, 0}, 12.0f);
+  d.lights[0].motion = test::translation({-0.6f, 0, 0}, {0.6f, 0, 0});
   auto s = Scene::build(d);
   float L = 12.0f / (kPi * 0.32f);
   double expected = 0;
