@@ -286,6 +286,8 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
   checkPhotonBudget(scene, opt);
   Timer timer;
   st = RenderStats{};
+  if (scene.lights.empty() && scene.background.isBlack())
+    st.warnings.push_back("the scene has no lights and a black background: the image will be black");
   Film film(scene.camera.width(), scene.camera.height());
   SamplingPlan plan;
   plan.batch = opt.spp;
