@@ -62,4 +62,20 @@ inline scene::SceneDescription emptyScene(int w, int h) {
   return d;
 }
 
+// A black sphere of `radius` crossing a white sky along x, from -travel to
+// +travel over the shutter, seen head-on from z = 10: every pixel's value is
+// 1 - the fraction of its area and time the sphere covers.
+inline scene::SceneDescription blackSphereAcrossSky(int w, int h, float fovDegrees, float radius, float travel) {
+  auto d = emptyScene(w, h);
+  d.background = Rgb(1.0f);
+  d.camera.position = {0, 0, 10};
+  d.camera.target = {0, 0, 0};
+  d.camera.fovDegrees = fovDegrees;
+  d.materials.push_back(diffuse(Rgb(0.0f)));
+  auto ball = sphere(radius, {0, 0, 0}, 0);
+  ball.motion = translation({-travel, 0, 0}, {travel, 0, 0});
+  d.objects.push_back(ball);
+  return d;
+}
+
 }  // namespace tdpm::test

@@ -131,3 +131,18 @@ TEST_CASE("cli: a scene that can only be black says so, and still renders") {
   CHECK(contains(r.output, "warning: the scene has no lights and a black background"));
   CHECK(test::fileExists(dir + "/dark.exr"));
 }
+
+TEST_CASE("cli: max_spp below spp names where each value came from, and writes nothing") {
+  std::string dir = test::makeTempDir();
+  test::writeFile(dir + "/s.json", R"({"camera": {"position": [0, 1, 4], "target": [0, 0, 0], "resolution": [8, 6]},
+    "objects": [{"shape": {"type": "quad", "size": [4, 4]}}],
+    "render": {"method": "pathtrace", "spp": 8, "max_spp": 16}})");
+  auto flag = runTdpm("render '" + dir + "/s.json' -o '" + dir + "/a.exr' --spp 32");
+  CHECK(flag.exitCode == 1);
+  CHECK(contains(flag.output, "max_spp 16 (render.max_spp in"));
+  CHECK(contains(flag.output, "is below spp 32 (--spp)"));
+  auto both = runTdpm("render '" + dir + "/s.json' -o '" + dir + "/b.exr' --max-spp 4");
+  CHECK(both.exitCode == 1);
+  CHECK(contains(both.output, "max_spp 4 (--max-spp) is below spp 8 (render.spp in"));
+  CHECK(test::countEntries(dir) == 1);  // only the scene file
+}

@@ -180,16 +180,8 @@ double coveredFraction(Vec3f o, Vec3f d, Vec3f c0, Vec3f v, float r) {
 }  // namespace
 
 TEST_CASE("motion blur: a black sphere crossing a white sky covers each pixel for the predicted fraction") {
-  auto d = test::emptyScene(24, 6);
-  d.background = Rgb(1.0f);
-  d.camera.position = {0, 0, 10};
-  d.camera.target = {0, 0, 0};
-  d.camera.fovDegrees = 10;
-  d.materials.push_back(test::diffuse(Rgb(0.0f)));
-  auto o = test::sphere(0.25f, {0, 0, 0}, 0);
+  auto d = test::blackSphereAcrossSky(24, 6, 10, 0.25f, 2.5f);
   Vec3f from{-2.5f, 0, 0}, to{2.5f, 0, 0};
-  o.motion = test::translation(from, to);
-  d.objects.push_back(o);
   Film f = renderScene(d, 256);
   Camera cam(d.camera);
   int checked = 0;

@@ -206,15 +206,7 @@ TEST_CASE("time method: only eye paths that can meet motion use the time-depende
 
 TEST_CASE("adaptive sampling: pixels the moving object never crosses get the minimum, its path gets more") {
   // A black sphere crossing a white sky: sky pixels are exactly constant.
-  auto d = test::emptyScene(32, 8);
-  d.background = Rgb(1.0f);
-  d.camera.position = {0, 0, 10};
-  d.camera.target = {0, 0, 0};
-  d.camera.fovDegrees = 12;
-  d.materials.push_back(test::diffuse(Rgb(0.0f)));
-  auto ball = test::sphere(0.5f, {0, 0, 0}, 0);
-  ball.motion = test::translation({-1.5f, 0, 0}, {1.5f, 0, 0});
-  d.objects.push_back(ball);
+  auto d = test::blackSphereAcrossSky(32, 8, 12, 0.5f, 1.5f);
   auto s = Scene::build(d);
   RenderOptions o;
   o.method = "pathtrace";

@@ -22,6 +22,7 @@
 #include "render/path_tracer.h"
 #include "render/photon_integrator.h"
 #include "render/photon_map.h"
+#include "render/film_output.h"
 #include "render/renderer.h"
 #include "scene_fixtures.h"
 
@@ -374,16 +375,7 @@ size_t nonFiniteInExr(const scene::SceneDescription& d, const std::string& metho
   o.causticPhotons = 20000;
   o.globalPhotons = 10000;
   Film f = renderScene(d, o);
-  image::ExrFile exr;
-  exr.color.width = f.width;
-  exr.color.height = f.height;
-  exr.color.pixels = f.color;
-  exr.extra.push_back({"spp", f.sampleCount});
-  for (int c = 0; c < 3; ++c) {
-    image::Channel ch{std::string("variance.") + "RGB"[c], {}};
-    for (const Rgb& v : f.varianceOfMean) ch.values.push_back(v[c]);
-    exr.extra.push_back(std::move(ch));
-  }
+  image::ExrFile exr = filmToExr(f);
   std::string path = test::makeTempDir() + "/huge.exr";
   image::writeExr(path, exr);
   image::ExrFile back = image::readExr(path);

@@ -15,6 +15,7 @@
 #include "core/timer.h"
 #include "image/exr.h"
 #include "image/png.h"
+#include "render/film_output.h"
 #include "render/renderer.h"
 #include "render/threads.h"
 #include "scene/parse.h"
@@ -141,7 +142,15 @@ RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc,
   // For the memory-budget error: name what set each count.
   if (!a.photons && sc.photons) o.causticPhotonsSource = "render.photons in " + sourcePath;
   if (!a.globalPhotons && sc.globalPhotons) o.globalPhotonsSource = "render.global_photons in " + sourcePath;
-  if (o.maxSpp < o.spp) throw Error("--max-spp (" + std::to_string(o.maxSpp) + ") is below --spp (" + std::to_string(o.spp) + ")");
+  if (o.maxSpp < o.spp) {
+    auto source = [&](bool flag, bool scene, const char* flagName, const char* key) {
+      return flag ? std::string(flagName) : scene ? "render." + std::string(key) + " in " + sourcePath : std::string("default");
+    };
+    throw Error("max_spp " + std::to_string(o.maxSpp) + " (" +
+                source(bool(a.maxSpp), bool(sc.maxSpp), "--max-spp", "max_spp") + ") is below spp " +
+                std::to_string(o.spp) + " (" + source(bool(a.spp), bool(sc.spp), "--spp", "spp") +
+                "): the adaptive maximum cannot be below the first batch");
+  }
   return o;
 }
 
@@ -225,17 +234,7 @@ int runRender(const RenderArgs& a) {
   bar.finish();
   for (const std::string& w : stats.warnings) std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
 
-  image::ExrFile exr;
-  exr.color.width = film.width;
-  exr.color.height = film.height;
-  exr.color.pixels = film.color;
-  exr.extra.push_back({"spp", film.sampleCount});
-  for (int c = 0; c < 3; ++c) {
-    image::Channel ch{std::string("variance.") + "RGB"[c], {}};
-    ch.values.reserve(film.varianceOfMean.size());
-    for (const Rgb& v : film.varianceOfMean) ch.values.push_back(v[c]);
-    exr.extra.push_back(std::move(ch));
-  }
+  image::ExrFile exr = filmToExr(film);
   char seconds[32];
   std::snprintf(seconds, sizeof seconds, "%.3f", stats.seconds);
   exr.metadata = {{"tdpm/version", TDPM_VERSION},
