@@ -1,19 +1,38 @@
 #!/usr/bin/env bash
-# Short bounded libFuzzer run of the scene loader and the EXR reader
-# (fuzz/): configures and builds build-fuzz with clang++ (TDPM_FUZZ=ON,
-# ASan + UBSan), then runs each target for SECONDS on a fresh copy of its
-# seed corpus. Fails (exit 1) on any crash, sanitizer report, leak, timeout
-# or out-of-memory; the reproducer is left in build-fuzz/findings/<target>/.
+# Bounded libFuzzer runs of the scene loader and the EXR reader (fuzz/):
+# configures and builds build-fuzz with clang++ (TDPM_FUZZ=ON, ASan +
+# UBSan), then runs each target on a fresh copy of its seed corpus. Fails
+# (exit 1) on any crash, sanitizer report, leak, timeout or out-of-memory;
+# the reproducer is left in build-fuzz/findings/<target>/.
 #
-#   scripts/fuzz.sh [SECONDS]     # default 25 per target
+#   scripts/fuzz.sh [SECONDS]            # explore: a random seed, SECONDS per target (default 25)
+#   scripts/fuzz.sh --seed N [SECONDS]   # replay an exploring run (its seed is printed)
+#   scripts/fuzz.sh --ci                 # what `scripts/setup.sh test` runs: seed 1 and a
+#                                        # fixed number of inputs, so the same commit
+#                                        # always runs the same inputs (no flaky CI)
 #
 # Seeds: scenes/*.json and tests/data/*.json for fuzz_scene; fuzz/corpus/exr/
-# (small EXRs written by tdpm) for fuzz_exr. The corpus copies grown by a run
-# are thrown away: the seeds in git stay small and reviewed.
+# (small EXRs written by tdpm or oiiotool, plus every input a run ever
+# failed on, named regress-*) for fuzz_exr. The corpus copies grown by a
+# run are thrown away: the seeds in git stay small and reviewed.
 set -euo pipefail
 
-seconds=${1:-25}
+seconds=25
+seed=""
+runs=-1
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --ci) seed=1; runs=40000; seconds=120 ;;  # 120 s: only a cap; 40000 inputs take ~5 s (scene) and ~20 s (exr) here
+    --seed) [ $# -ge 2 ] || { echo "fuzz.sh: --seed needs a number" >&2; exit 2; }; seed=$2; shift ;;
+    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) seconds=$1 ;;
+  esac
+  shift
+done
 case "$seconds" in ''|*[!0-9]*) echo "fuzz.sh: SECONDS must be a whole number, got '$seconds'" >&2; exit 2 ;; esac
+case "$seed" in *[!0-9]*) echo "fuzz.sh: --seed must be a whole number, got '$seed'" >&2; exit 2 ;; esac
+[ "$seconds" -gt 0 ] || { echo "fuzz.sh: SECONDS must be positive" >&2; exit 2; }
+[ -n "$seed" ] || seed=$(( (RANDOM << 15 | RANDOM) + 1 ))
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
@@ -39,14 +58,17 @@ for target in scene exr; do
   log=build-fuzz/fuzz_$target.log
   # -timeout: one input taking over 10 s is a hang; -rss_limit_mb: a
   # runaway allocation is a finding too. ASan's leak check stays on.
-  if build-fuzz/fuzz/fuzz_$target "$work/$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
-       -artifact_prefix="$findings/" -print_final_stats=1 >"$log" 2>&1; then
-    runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')
+  if build-fuzz/fuzz/fuzz_$target "$work/$target" -seed="$seed" -runs="$runs" -max_total_time="$seconds" \
+       -timeout=10 -rss_limit_mb=2048 -artifact_prefix="$findings/" -print_final_stats=1 >"$log" 2>&1; then
+    done_runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')
     cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*' || echo '?')
-    echo "fuzz.sh: fuzz_$target: ok, $runs inputs in ${seconds} s ($(( ${runs:-0} / seconds )) per second), coverage $cov edges, corpus $(ls "$work/$target" | wc -l) files"
+    secs=$(grep -o 'Done [0-9]* runs in [0-9]* second' "$log" | grep -o 'in [0-9]*' | grep -o '[0-9]*' || echo "$seconds")
+    capped=""
+    [ "$runs" -gt 0 ] && [ "$done_runs" != "$runs" ] && capped=" (stopped by the ${seconds}-s cap before $runs: not a replayable run)"
+    echo "fuzz.sh: fuzz_$target: ok, seed $seed, $done_runs inputs in ${secs} s$capped, coverage $cov edges, corpus $(ls "$work/$target" | wc -l) files"
   else
     status=1
-    echo "fuzz.sh: fuzz_$target: FAILED; reproducer in $findings/, log $log:" >&2
+    echo "fuzz.sh: fuzz_$target: FAILED (seed $seed); reproducer in $findings/, log $log:" >&2
     grep -E 'ERROR|SUMMARY|==[0-9]+==|Test unit written' "$log" | head -20 >&2 || tail -30 "$log" >&2
   fi
 done

@@ -271,6 +271,91 @@ TEST_CASE("exr: missing, non-EXR, truncated and corrupt files are tdpm::Error na
   MESSAGE(errors << " of 300 corrupted files were rejected with tdpm::Error");
 }
 
+// Hand-built headers: each one made OpenEXR 3.1 allocate far more than the
+// file holds (0.1-16 GB from a few hundred bytes; fuzz_exr found the first
+// two). image/exr_header_check must reject them before OpenEXR sees them,
+// with a message saying which attribute is wrong.
+namespace {
+
+struct HeaderBytes {
+  std::string bytes = std::string("\x76\x2f\x31\x01\x02\x00\x00\x00", 8);
+  HeaderBytes& attr(const std::string& name, const std::string& type, const std::string& value,
+                    int64_t declared = -1) {
+    const int32_t size = int32_t(declared >= 0 ? declared : int64_t(value.size()));
+    bytes += name + '\0' + type + '\0';
+    for (int i = 0; i < 4; ++i) bytes += char((uint32_t(size) >> (8 * i)) & 0xff);
+    bytes += value;
+    return *this;
+  }
+  static std::string i32s(std::initializer_list<int32_t> values) {
+    std::string out;
+    for (int32_t v : values)
+      for (int i = 0; i < 4; ++i) out += char((uint32_t(v) >> (8 * i)) & 0xff);
+    return out;
+  }
+  static std::string channel(const std::string& name) {  // FLOAT, sampling 1x1
+    return name + '\0' + i32s({2}) + std::string(4, '\0') + i32s({1, 1});
+  }
+  // The attributes every scanline image needs, for a w x h data window.
+  HeaderBytes& image(int32_t w, int32_t h) {
+    attr("channels", "chlist", channel("R") + channel("G") + channel("B") + '\0');
+    attr("compression", "compression", std::string(1, '\0'));
+    attr("dataWindow", "box2i", i32s({0, 0, w - 1, h - 1}));
+    attr("displayWindow", "box2i", i32s({0, 0, w - 1, h - 1}));
+    attr("lineOrder", "lineOrder", std::string(1, '\0'));
+    attr("pixelAspectRatio", "float", i32s({0x3f800000}));
+    attr("screenWindowCenter", "v2f", std::string(8, '\0'));
+    return attr("screenWindowWidth", "float", i32s({0x3f800000}));
+  }
+  std::string end() const { return bytes + '\0' + std::string(64, '\0'); }
+};
+
+}  // namespace
+
+TEST_CASE("exr: headers whose sizes lie are rejected before OpenEXR allocates") {
+  TempDir dir;
+  const std::string path = dir / "lie.exr";
+  auto expect = [&](const std::string& bytes, std::initializer_list<std::string> parts) {
+    writeBytes(path, bytes);
+    checkError([&] { readExr(path); }, {path, "corrupt OpenEXR header"});
+    checkError([&] { readExr(path); }, parts);
+  };
+  using H = HeaderBytes;
+
+  // The well-formed base reads past the header check (and then fails on the
+  // missing pixel data, which is a different error).
+  writeBytes(path, H().image(4, 3).end());
+  try {
+    readExr(path);
+    FAIL("a header without pixel data was read");
+  } catch (const Error& e) {
+    CHECK(std::string(e.what()).find("corrupt OpenEXR header") == std::string::npos);
+  }
+
+  // A string claiming more bytes than the file has (OpenEXR allocated it).
+  expect(H().image(4, 3).attr("owner", "string", "me", 1900000000).end(), {"'owner'", "claims 1900000000"});
+  // A channel list whose declared size disagrees with its channels: OpenEXR
+  // reads the channels, then takes later bytes as the next attribute's size.
+  expect(H().attr("channels", "chlist", H::channel("R") + '\0', 156).image(4, 3).end(),
+         {"'channels'", "declares 156", "take 19"});
+  // A fixed-size type with a wrong declared size.
+  expect(H().attr("dataWindow", "box2i", H::i32s({0, 0, 3}), 12).image(4, 3).end(),
+         {"'dataWindow'", "declares 12", "has 16"});
+  // A preview image whose width x height OpenEXR would allocate.
+  expect(H().image(4, 3).attr("preview", "preview", H::i32s({60000, 60000}), 8).end(),
+         {"'preview'", "60000x60000"});
+  // A data window of 2^32 pixels, and a tiling of 2^27 tiles of 1x1.
+  expect(H().image(65536, 65536).end(), {"data window 65536x65536"});
+  // (A repeated attribute replaces the earlier one, in OpenEXR too.)
+  expect(H().image(4, 3)
+             .attr("dataWindow", "box2i", H::i32s({-2147483647 - 1, -2147483647 - 1, 2147483647, 2147483647}))
+             .end(),
+         {"data window 4294967296x4294967296"});
+  expect(H().image(16384, 8192).attr("tiles", "tiledesc", H::i32s({1, 1}) + '\0').end(), {"134217728 tiles"});
+  // The chunk count that sizes the offset table of a part of unknown type.
+  expect(H().image(4, 3).attr("chunkCount", "int", H::i32s({2000000000})).end(), {"'chunkCount'", "2000000000"});
+}
+
 // ---- atomic output ----
 
 TEST_CASE("atomic: failures leave neither a target nor a temporary file") {
