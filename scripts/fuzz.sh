@@ -8,8 +8,8 @@
 #   scripts/fuzz.sh [SECONDS]            # explore: a random seed, SECONDS per target (default 25)
 #   scripts/fuzz.sh --seed N [SECONDS]   # replay an exploring run (its seed is printed)
 #   scripts/fuzz.sh --ci                 # what `scripts/setup.sh test` runs: seed 1 and a
-#                                        # fixed number of inputs, so the same commit
-#                                        # always runs the same inputs (no flaky CI)
+#                                        # fixed number of inputs, so CI does not fail by
+#                                        # luck and a failure replays
 #
 # Seeds: scenes/*.json and tests/data/*.json for fuzz_scene; fuzz/corpus/exr/
 # (small EXRs written by tdpm or oiiotool, plus every input a run ever

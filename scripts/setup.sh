@@ -51,8 +51,8 @@ case "$mode" in
     ;;
   test)
     # A short fuzzing run of the scene loader and the EXR reader with a fixed
-    # seed and input count (the same inputs for the same commit: CI cannot
-    # flake; about 1.5 min with its clang build on 2 cores), first, so that
+    # seed and input count (CI does not fail by luck, a failure replays;
+    # about 1.5 min with its clang build on 2 cores), first, so that
     # CTest's summary is the last thing printed.
     scripts/fuzz.sh --ci && echo "setup.sh: fuzzing: no findings" || { echo "setup.sh: fuzzing FAILED (see above)" >&2; exit 1; }
     (cd build && ctest --output-on-failure -j "$jobs")

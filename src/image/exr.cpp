@@ -51,14 +51,12 @@ void precheckInput(const std::string& path) {
   size_t n = std::fread(magic, 1, 8, f);
   // EXR magic number 20000630 = 0x01312f76, stored little-endian.
   const unsigned char expected[4] = {0x76, 0x2f, 0x31, 0x01};
-  if (n < 4 || std::memcmp(magic, expected, 4) != 0) {
-    std::fclose(f);
-    throw Error(path + ": not an OpenEXR file (bad magic number)");
-  }
-  std::fclose(f);
+  const bool isExr = n >= 4 && std::memcmp(magic, expected, 4) == 0;
   // OpenEXR trusts the header's sizes when it allocates (see
   // image/exr_header_check.h): check them first.
-  const std::string bad = checkExrHeader(path);
+  const std::string bad = isExr ? checkExrHeader(f) : std::string();
+  std::fclose(f);
+  if (!isExr) throw Error(path + ": not an OpenEXR file (bad magic number)");
   if (!bad.empty()) throw Error(path + ": corrupt OpenEXR header: " + bad);
 }
 

@@ -5,9 +5,6 @@
 // ended by an empty name. All integers are little-endian.
 #include "image/exr_header_check.h"
 
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
 #include <map>
 
 namespace tdpm::image {
@@ -176,55 +173,33 @@ std::string checkValue(Reader& in, const std::string& name, const std::string& t
 
 }  // namespace
 
-std::string checkExrHeader(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return std::string("cannot open: ") + std::strerror(errno);
-  Reader in(f);
+std::string checkExrHeader(std::FILE* f) {
+  Reader in(f);  // from the start of the file
   unsigned char start[8];
-  std::string problem;
-  if (!in.bytes(start, 8)) {
-    problem = "file ends inside the version field";
-  } else {
-    const bool multipart = (start[5] & 0x10) != 0;
-    for (int part = 0; problem.empty(); ++part) {
-      if (part >= 1 << 16) {
-        problem = "more than 65536 parts";
-        break;
-      }
-      PartShape shape;
-      int attributes = 0;
-      for (std::string name, type;; ++attributes) {
-        if (!in.name(name)) {
-          problem = "header " + std::to_string(part) + " is cut short or has a name over 255 characters";
-          break;
-        }
-        if (name.empty()) break;  // end of this header
-        if (!in.name(type)) {
-          problem = "attribute '" + name + "' has no type (file cut short)";
-          break;
-        }
-        int32_t size;
-        if (!in.i32(size)) {
-          problem = quoted(name, type) + " has no size (file cut short)";
-          break;
-        }
-        if (size < 0 || uint64_t(size) > in.left()) {
-          problem = quoted(name, type) + " claims " + std::to_string(size) + " bytes, but the file has " +
-                    std::to_string(in.left()) + " left";
-          break;
-        }
-        problem = checkValue(in, name, type, size, shape);
-        if (!problem.empty()) break;
-      }
-      if (!problem.empty()) break;
-      problem = checkShape(shape);
-      // A single-part file has one header; a multi-part file ends its list
-      // of headers with an empty one.
-      if (!multipart || attributes == 0) break;
+  if (!in.bytes(start, 8)) return "file ends inside the version field";
+  const bool multipart = (start[5] & 0x10) != 0;
+  for (int part = 0; part < 1 << 16; ++part) {
+    PartShape shape;
+    int attributes = 0;
+    for (std::string name, type;; ++attributes) {
+      if (!in.name(name)) return "header " + std::to_string(part) + " is cut short or has a name over 255 characters";
+      if (name.empty()) break;  // end of this header
+      if (!in.name(type)) return "attribute '" + name + "' has no type (file cut short)";
+      int32_t size;
+      if (!in.i32(size)) return quoted(name, type) + " has no size (file cut short)";
+      if (size < 0 || uint64_t(size) > in.left())
+        return quoted(name, type) + " claims " + std::to_string(size) + " bytes, but the file has " +
+               std::to_string(in.left()) + " left";
+      std::string problem = checkValue(in, name, type, size, shape);
+      if (!problem.empty()) return problem;
     }
+    std::string problem = checkShape(shape);
+    if (!problem.empty()) return problem;
+    // A single-part file has one header; a multi-part file ends its list
+    // of headers with an empty one.
+    if (!multipart || attributes == 0) return "";
   }
-  std::fclose(f);
-  return problem;
+  return "more than 65536 parts";
 }
 
 }  // namespace tdpm::image

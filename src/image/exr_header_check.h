@@ -13,6 +13,7 @@
 // for tdpm, so that OpenEXR only ever gets headers with bounded allocations.
 #pragma once
 #include <cstdint>
+#include <cstdio>
 #include <string>
 
 namespace tdpm::image {
@@ -21,10 +22,10 @@ namespace tdpm::image {
 constexpr int64_t kMaxExrPixels = int64_t(1) << 27;  // 16k x 8k
 constexpr int64_t kMaxExrTiles = int64_t(1) << 20;   // per level-0 image
 
-// Walks the header(s) of the EXR file at `path` (already known to exist and
-// to start with the EXR magic number). Returns "" if they are well formed,
-// else a short description of the first problem, e.g. "attribute
-// 'dataWindow' (box2i) declares 7 bytes, its type has 16".
-std::string checkExrHeader(const std::string& path);
+// Walks the header(s) of the open EXR file `f` from its start (the caller
+// has checked the magic number; the position is left anywhere). Returns ""
+// if they are well formed, else a short description of the first problem,
+// e.g. "attribute 'dataWindow' (box2i) declares 7 bytes; its type has 16".
+std::string checkExrHeader(std::FILE* f);
 
 }  // namespace tdpm::image
