@@ -1,9 +1,11 @@
-// scene/json_locate.cpp — the one-pass JSON position scanner behind every
-// located scene-file error (see json_locate.h). Iterative, not recursive, so
-// a maliciously deep file cannot overflow the stack.
+// scene/json_locate.cpp — the JSON position scanner behind every located
+// scene-file error (see json_locate.h). Iterative, not recursive, so a
+// maliciously deep file cannot overflow the stack; it keeps one path string
+// (appended and truncated as it walks), never one per value or per level.
 #include "scene/json_locate.h"
 
 #include <algorithm>
+#include <unordered_set>
 
 namespace tdpm::scene {
 
@@ -64,40 +66,26 @@ size_t firstInvalidUtf8(const std::string& text) {
   return std::string::npos;
 }
 
-JsonLocator::JsonLocator(const std::string& text) : text_(text) {
-  // nlohmann skips a UTF-8 byte-order mark; so do we.
-  if (text_.compare(0, 3, "\xEF\xBB\xBF") == 0) pos_ = 3;
-  scan();
+size_t firstTooDeep(const std::string& text, int maxDepth) {
+  int depth = 0;
+  bool inString = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    char c = text[i];
+    if (inString) {
+      if (c == '\\') ++i;  // the escaped character cannot end the string
+      else if (c == '"') inString = false;
+    } else if (c == '"') {
+      inString = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > maxDepth) return i;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return std::string::npos;
 }
 
-int JsonLocator::line(const std::string& path) const {
-  for (std::string p = path;; p = parentPath(p)) {
-    auto it = entries_.find(p);
-    if (it != entries_.end()) return it->second.line;
-    if (p.empty()) return 1;
-  }
-}
-
-std::string JsonLocator::findNumber(const std::string& token) const {
-  std::string best;
-  size_t bestOffset = std::string::npos;
-  for (const auto& [path, e] : entries_) {
-    if (e.offset >= bestOffset || text_.compare(e.offset, token.size(), token) != 0) continue;
-    size_t end = e.offset + token.size();
-    bool whole = end >= text_.size() || std::string(",]} \t\r\n").find(text_[end]) != std::string::npos;
-    if (whole) { best = path; bestOffset = e.offset; }
-  }
-  return best;
-}
-
-void JsonLocator::skipWhitespace() {
-  while (pos_ < text_.size()) {
-    char c = text_[pos_];
-    if (c == '\n') ++line_;
-    else if (c != ' ' && c != '\t' && c != '\r') return;
-    ++pos_;
-  }
-}
+namespace {
 
 // Appends code point `cp` to `out` as UTF-8.
 static void appendUtf8(std::string* out, unsigned cp) {
@@ -132,102 +120,207 @@ static bool readHex4(const std::string& t, size_t at, unsigned* v) {
   return true;
 }
 
-// Reads the string at pos_ (which is '"'), decoding escapes exactly as
-// nlohmann does, so that keys in paths match the parsed object's keys.
-bool JsonLocator::readString(std::string* decoded) {
-  ++pos_;
-  while (pos_ < text_.size()) {
-    char c = text_[pos_++];
-    if (c == '"') return true;
-    if (c != '\\') { if (decoded) decoded->push_back(c); continue; }
-    if (pos_ >= text_.size()) return false;
-    char e = text_[pos_++];
-    unsigned cp = 0;
-    switch (e) {
-      case 'b': cp = '\b'; break;
-      case 'f': cp = '\f'; break;
-      case 'n': cp = '\n'; break;
-      case 'r': cp = '\r'; break;
-      case 't': cp = '\t'; break;
-      case 'u': {
-        if (!readHex4(text_, pos_, &cp)) return false;
-        pos_ += 4;
-        unsigned low = 0;  // a surrogate pair is one code point
-        if (cp >= 0xD800 && cp <= 0xDBFF && text_.compare(pos_, 2, "\\u") == 0 &&
-            readHex4(text_, pos_ + 2, &low) && low >= 0xDC00 && low <= 0xDFFF) {
-          cp = 0x10000 + ((cp - 0xD800) << 10) + (low - 0xDC00);
-          pos_ += 6;
+// One walk over the text, value by value, keeping the current value's JSON
+// path in a single string. Calls visit(offset, line) at the start of every
+// value (path() is its path); visit returns false to stop the walk.
+class Walker {
+ public:
+  Walker(const std::string& text, size_t start) : t_(text), pos_(start) {}
+
+  const std::string& path() const { return path_; }
+  bool trackKeys = false;   // keep each object's keys (for duplicates)
+  // With a target: `matched` tells whether path() is a prefix of *target
+  // (component by component, so each byte of a path is compared once).
+  const std::string* target = nullptr;
+  bool matched = true;
+  bool duplicate = false;   // the current member repeats a key of its object
+  int keyLine = 0;          // line of the current member's key
+
+  template <class Visit>
+  void run(Visit&& visit) {
+    matched = true;
+    if (!beginValue(visit)) return;
+    while (!stack_.empty())
+      if (!next(visit)) return;
+  }
+
+ private:
+  struct Frame {
+    bool isObject;
+    size_t count = 0;    // elements or members seen so far
+    size_t pathLen = 0;  // length of the container's own path
+    bool matched = true; // the container's path is a prefix of *target
+    std::unordered_set<std::string> keys;
+  };
+
+  void skipWhitespace() {
+    while (pos_ < t_.size()) {
+      char c = t_[pos_];
+      if (c == '\n') ++line_;
+      else if (c != ' ' && c != '\t' && c != '\r') return;
+      ++pos_;
+    }
+  }
+
+  // Reads the string at pos_ (which is '"'), decoding escapes exactly as
+  // nlohmann does, so that keys in paths match the parsed object's keys.
+  bool readString(std::string* decoded) {
+    ++pos_;
+    while (pos_ < t_.size()) {
+      char c = t_[pos_++];
+      if (c == '"') return true;
+      if (c != '\\') { if (decoded) decoded->push_back(c); continue; }
+      if (pos_ >= t_.size()) return false;
+      char e = t_[pos_++];
+      unsigned cp = 0;
+      switch (e) {
+        case 'b': cp = '\b'; break;
+        case 'f': cp = '\f'; break;
+        case 'n': cp = '\n'; break;
+        case 'r': cp = '\r'; break;
+        case 't': cp = '\t'; break;
+        case 'u': {
+          if (!readHex4(t_, pos_, &cp)) return false;
+          pos_ += 4;
+          unsigned low = 0;  // a surrogate pair is one code point
+          if (cp >= 0xD800 && cp <= 0xDBFF && t_.compare(pos_, 2, "\\u") == 0 && readHex4(t_, pos_ + 2, &low) &&
+              low >= 0xDC00 && low <= 0xDFFF) {
+            cp = 0x10000 + ((cp - 0xD800) << 10) + (low - 0xDC00);
+            pos_ += 6;
+          }
+          break;
         }
-        break;
+        default: cp = static_cast<unsigned char>(e);  // \" \\ \/
       }
-      default: cp = static_cast<unsigned char>(e);  // \" \\ \/
+      if (decoded) appendUtf8(decoded, cp);
     }
-    if (decoded) appendUtf8(decoded, cp);
+    return false;
   }
-  return false;
-}
 
-void JsonLocator::skipScalar() {
-  while (pos_ < text_.size() && std::string(",]} \t\r\n").find(text_[pos_]) == std::string::npos) ++pos_;
-}
+  void skipScalar() {
+    while (pos_ < t_.size()) {
+      char c = t_[pos_];
+      if (c == ',' || c == ']' || c == '}' || c == ' ' || c == '\t' || c == '\r' || c == '\n') return;
+      ++pos_;
+    }
+  }
 
-// Records the value starting at pos_ and enters it if it is a container.
-bool JsonLocator::beginValue(const std::string& path) {
-  skipWhitespace();
-  if (pos_ >= text_.size()) return false;
-  entries_.emplace(path, Entry{line_, pos_});
-  char c = text_[pos_];
-  if (c == '{' || c == '[') {
-    ++pos_;
-    stack_.push_back(Frame{c == '{', path, 0, {}});
+  // The value at pos_: visited, then entered if it is a container.
+  template <class Visit>
+  bool beginValue(Visit& visit) {
+    skipWhitespace();
+    if (pos_ >= t_.size()) return false;
+    if (!visit(pos_, line_)) return false;
+    char c = t_[pos_];
+    if (c == '{' || c == '[') {
+      ++pos_;
+      stack_.push_back(Frame{c == '{', 0, path_.size(), matched, {}});
+      return true;
+    }
+    if (c == '"') return readString(nullptr);
+    skipScalar();
     return true;
   }
-  if (c == '"') return readString(nullptr);
-  skipScalar();
-  return true;
-}
 
-// Handles the next member/element of the innermost container, or its end.
-bool JsonLocator::nextInFrame() {
-  skipWhitespace();
-  if (pos_ >= text_.size()) return false;
-  char c = text_[pos_];
-  if (c == '}' || c == ']') {
-    ++pos_;
-    stack_.pop_back();
-    return true;
-  }
-  if (c == ',') {
-    ++pos_;
+  // The next member/element of the innermost container, or its end.
+  template <class Visit>
+  bool next(Visit& visit) {
     skipWhitespace();
-  }
-  Frame& f = stack_.back();
-  std::string path;
-  if (f.isObject) {
-    int keyLine = line_;
-    std::string key;
-    if (pos_ >= text_.size() || text_[pos_] != '"' || !readString(&key)) return false;
-    skipWhitespace();
-    if (pos_ >= text_.size() || text_[pos_] != ':') return false;
-    ++pos_;
-    path = childPath(f.path, key);
-    if (std::find(f.keys.begin(), f.keys.end(), key) != f.keys.end()) {
-      duplicates_.push_back({path, keyLine});
-      // The later value wins in nlohmann, and so in the located position.
-      entries_.erase(path);
+    if (pos_ >= t_.size()) return false;
+    char c = t_[pos_];
+    if (c == '}' || c == ']') {
+      ++pos_;
+      stack_.pop_back();
+      return true;
     }
-    f.keys.push_back(key);
-  } else {
-    path = elementPath(f.path, f.count);
+    if (c == ',') {
+      ++pos_;
+      skipWhitespace();
+    }
+    Frame& f = stack_.back();
+    path_.resize(f.pathLen);
+    duplicate = false;
+    if (f.isObject) {
+      keyLine = line_;
+      key_.clear();
+      if (pos_ >= t_.size() || t_[pos_] != '"' || !readString(&key_)) return false;
+      skipWhitespace();
+      if (pos_ >= t_.size() || t_[pos_] != ':') return false;
+      ++pos_;
+      if (!path_.empty()) path_ += '.';
+      path_ += key_;
+      if (trackKeys) duplicate = !f.keys.insert(key_).second;
+    } else {
+      path_ += '[';
+      path_ += std::to_string(f.count);
+      path_ += ']';
+    }
+    ++f.count;
+    if (target) {
+      size_t added = path_.size() - f.pathLen;
+      matched = f.matched && path_.size() <= target->size() &&
+                target->compare(f.pathLen, added, path_, f.pathLen, added) == 0;
+    }
+    return beginValue(visit);  // may push: f is not used afterwards
   }
-  ++f.count;
-  return beginValue(path);  // may push: f is not used afterwards
+
+  const std::string& t_;
+  size_t pos_;
+  int line_ = 1;
+  std::string path_, key_;
+  std::vector<Frame> stack_;
+};
+
+// nlohmann skips a UTF-8 byte-order mark; so do we.
+size_t afterBom(const std::string& text) { return text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0; }
+
+}  // namespace
+
+JsonLocator::JsonLocator(const std::string& text) : text_(text), start_(afterBom(text_)) {
+  Walker w(text_, start_);
+  w.trackKeys = true;
+  w.run([&](size_t, int) {
+    if (!w.duplicate) return true;
+    duplicates_.push_back({w.path(), w.keyLine});
+    return false;
+  });
 }
 
-void JsonLocator::scan() {
-  if (!beginValue("")) return;
-  while (!stack_.empty())
-    if (!nextInFrame()) return;
+int JsonLocator::line(const std::string& path) const {
+  // The path and its ancestors are prefixes of `path`: follow, per level,
+  // whether the walk's current path still equals a prefix of `path` (each
+  // new component is compared once, so the walk stays linear).
+  std::vector<size_t> candidates;  // lengths of path, its parent, ..., ""
+  for (std::string p = path;; p = parentPath(p)) {
+    candidates.push_back(p.size());
+    if (p.empty()) break;
+  }
+  std::vector<int> found(candidates.size(), 0);
+  Walker w(text_, start_);
+  w.target = &path;
+  w.run([&](size_t, int line) {
+    if (!w.matched) return true;
+    for (size_t i = 0; i < candidates.size(); ++i)
+      if (candidates[i] == w.path().size()) found[i] = line;  // a later duplicate wins, as in nlohmann
+    return true;
+  });
+  for (size_t i = 0; i < candidates.size(); ++i)
+    if (found[i]) return found[i];
+  return 1;
+}
+
+std::string JsonLocator::findNumber(const std::string& token) const {
+  std::string result;
+  Walker w(text_, start_);
+  w.run([&](size_t offset, int) {
+    if (text_.compare(offset, token.size(), token) != 0) return true;
+    size_t end = offset + token.size();
+    bool whole = end >= text_.size() || std::string(",]} \t\r\n").find(text_[end]) != std::string::npos;
+    if (!whole) return true;
+    result = w.path();
+    return false;
+  });
+  return result;
 }
 
 }  // namespace tdpm::scene

@@ -17,6 +17,7 @@
 
 #include "core/error.h"
 #include "scene/json_locate.h"
+#include "scene/limits.h"
 #include "scene/mesh_obj.h"
 #include "scene/parse_node.h"
 
@@ -575,7 +576,7 @@ SceneDescription readScene(const Node& root, const std::string& sourcePath) {
   throw Error(file + ":" + std::to_string(p.line) + ":" + std::to_string(p.column) + ": " + problem);
 }
 
-// Checks that do not need parsed JSON: empty text, bad UTF-8.
+// Checks that do not need parsed JSON: empty text, bad UTF-8, nesting depth.
 void checkText(const std::string& text, const std::string& file) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos)
     throw Error(file + ":1: the file is empty (expected a JSON object)");
@@ -585,6 +586,11 @@ void checkText(const std::string& text, const std::string& file) {
     std::snprintf(hex, sizeof hex, "0x%02X", unsigned(static_cast<unsigned char>(text[bad])));
     failAt(file, text, bad, std::string("not valid UTF-8 text (byte ") + hex + "); is this a JSON scene file?");
   }
+  // Before nlohmann parses: its parser recurses once per level.
+  size_t deep = firstTooDeep(text, limits::kMaxJsonDepth);
+  if (deep != std::string::npos)
+    failAt(file, text, deep,
+           "arrays and objects are nested too deeply (at most " + std::to_string(limits::kMaxJsonDepth) + " levels)");
 }
 
 // nlohmann's message minus its own "[json.exception...] parse error at ...: " prefix.
@@ -634,12 +640,26 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
 SceneDescription loadScene(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw Error(path + ": cannot read scene file: it is a directory");
+  // A device or pipe (/dev/zero) could be read forever: only regular files.
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    throw Error(path + ": cannot read scene file: it is not a regular file");
+  const std::string limit = std::to_string(limits::kMaxSceneFileBytes >> 20) + " MiB";
+  uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size > limits::kMaxSceneFileBytes)
+    throw Error(path + ": scene file is too large (" + std::to_string(size) + " bytes; at most " + limit +
+                "; put large meshes in OBJ files)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path + ": cannot read scene file (" + std::strerror(errno) + ")");
-  std::ostringstream text;
-  text << in.rdbuf();
+  // Read at most one byte over the limit, in case the file grew since the check.
+  std::string text;
+  char chunk[1 << 16];
+  while (in.read(chunk, sizeof chunk), in.gcount() > 0) {
+    text.append(chunk, size_t(in.gcount()));
+    if (text.size() > limits::kMaxSceneFileBytes)
+      throw Error(path + ": scene file is too large (more than " + limit + ")");
+  }
   if (in.bad()) throw Error(path + ": error while reading scene file");
-  return parseScene(text.str(), path);
+  return parseScene(text, path);
 }
 
 }  // namespace tdpm::scene

@@ -1,0 +1,80 @@
+// scene/limits.h — owns the input limits of tdpm: what a scene file, a mesh
+// file and the render command's flags may ask for. One table, read by the
+// scene parser (scene/parse.cpp) and by the command line
+// (cli/render_command.cpp), so that a flag and its scene key cannot drift
+// apart. docs/scene-format.md ("Limits") is the user-facing version.
+#pragma once
+#include <cstdint>
+
+namespace tdpm::scene::limits {
+
+// ---- files
+// A scene file larger than this is refused before it is read. nlohmann-json
+// needs ~25 bytes of memory per byte of dense JSON (a 200 MB scene took
+// 5.2 GB and 48 s before its first error), and a real scene is a few KB:
+// meshes live in their own files.
+constexpr uint64_t kMaxSceneFileBytes = uint64_t(16) << 20;  // 16 MiB
+// A mesh file larger than this is refused before it is read (an OBJ line
+// costs ~30-60 bytes per vertex/face; 1 GiB is ~20M triangles).
+constexpr uint64_t kMaxMeshFileBytes = uint64_t(1) << 30;  // 1 GiB
+// Deepest nesting of arrays/objects in a scene file. The deepest valid key
+// path is 6 levels (objects[i].motion[j].rotate.axis[k]); checked before
+// nlohmann-json parses, since nlohmann's parser recurses.
+constexpr int kMaxJsonDepth = 64;
+
+// ---- coordinates
+// Largest absolute coordinate (metres) of anything the ray tracer sees:
+// every object's vertices or sphere bounds, in object space and in world
+// space over the whole shutter, lights and camera (position and target).
+// Measured: a floor quad + sphere + point light + camera scene scaled by s
+// (power by s^2) renders the same pathtrace/time image as at s = 1 up to
+// s = 2e8 (coordinates up to 1e9) and aborts in Embree ('ray.valid()') from
+// s = 5e8 on: a face normal is computed as |cross(b - a, c - a)| in float,
+// which overflows at edge lengths near 4e9 (it grows as length^4). With
+// every coordinate within 1e9, an edge component is at most 2e9, a cross
+// component at most 8e18 and the squared length at most 1.9e38 < FLT_MAX.
+constexpr float kMaxCoordinate = 1e9f;
+// Scale factors (placement times keyframe scale, per axis): a transform's
+// determinant (sx sy sz) and its inverse must be finite, non-zero floats
+// (1e12^3 = 1e36 < FLT_MAX, 1e-12^3 = 1e-36 > FLT_MIN).
+constexpr float kMinScale = 1e-12f;
+constexpr float kMaxScale = 1e12f;
+
+// ---- render settings: the flag and the scene key share one range
+struct IntRange {
+  int64_t lo, hi;
+};
+constexpr IntRange kSpp{1, int64_t(1) << 20};
+constexpr IntRange kMaxDepth{1, 1024};
+constexpr IntRange kFrames{1, 4096};
+constexpr IntRange kK{1, 4096};
+constexpr IntRange kGather{0, 1024};
+// 2^31 photons at 20 bytes is 40 GiB: more is certainly a typo.
+constexpr IntRange kPhotons{0, int64_t(1) << 31};
+
+struct FloatRange {
+  float lo, hi;
+};
+constexpr FloatRange kFraction{1e-6f, 1.0f};
+constexpr FloatRange kExposure{-64.0f, 64.0f};
+
+// ---- the 4D metric d^2 = |dx|^2 + kappa dt^2
+// The 4D kd-tree keys time as sqrt(kappa) t in float and resolves it to one
+// of photon::kTimeBins bins (photon/store.h; cli/render_command.cpp checks
+// the two agree). kappa is usable when the squared time distance of one bin
+// is a normal float (not flushed to zero, which loses time altogether) and
+// that of the whole shutter stays far from overflow (headroom for the sum
+// with |dx|^2). The usable kappa for a shutter of `length` seconds is
+// [lo, hi]; a zero-length shutter has no time to weigh (any kappa > 0).
+constexpr int kTimeBins = 256;
+struct KappaRange {
+  double lo, hi;
+};
+inline KappaRange kappaRange(double shutterLength) {
+  const double floatMin = 1.17549435e-38, floatMax = 3.40282347e+38;
+  if (!(shutterLength > 0)) return {0.0, floatMax};
+  double bin = shutterLength / kTimeBins;
+  return {floatMin / (bin * bin), floatMax / 4 / (shutterLength * shutterLength)};
+}
+
+}  // namespace tdpm::scene::limits
