@@ -18,12 +18,28 @@
 #include "render/film_output.h"
 #include "render/renderer.h"
 #include "render/threads.h"
+#include "photon/store.h"
+#include "scene/limits.h"
 #include "scene/parse.h"
 #include "scene/scene.h"
 
 namespace tdpm::cli {
 
 namespace {
+
+namespace limits = scene::limits;
+static_assert(limits::kTimeBins == photon::kTimeBins, "the kappa range in scene/limits.h assumes the photon time bins");
+
+template <class R>
+CLI::Range rangeOf(R r) {
+  return CLI::Range(r.lo, r.hi);
+}
+
+std::string formatG(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
 
 std::string methodList() {
   std::string s;
@@ -162,18 +178,18 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_option("-o,--output", a.output, "Output EXR path (default: <scene name>.exr here); the PNG preview goes beside it");
   c->add_option("-m,--method", a.method, "Rendering method: " + methodList() + " (default: the scene's, else time)");
   c->add_option("--spp", a.spp, "Samples per pixel in the first pass, and per extra adaptive batch (default 16)")
-      ->check(CLI::Range(1, 1 << 20));
+      ->check(rangeOf(limits::kSpp));
   c->add_option("--max-spp", a.maxSpp, "Adaptive sampling: at most this many samples per pixel (default: --spp, i.e. not adaptive)")
-      ->check(CLI::Range(1, 1 << 20));
+      ->check(rangeOf(limits::kSpp));
   c->add_option("--contrast", a.contrast,
                 "Adaptive sampling: add batches while the relative standard error of a pixel's mean exceeds this (default 0.05)")
       ->check(CLI::PositiveNumber);
   c->add_option("--seed", a.seed, "Random seed >= 0: same seed, same image, whatever --threads is")
       ->check(CLI::NonNegativeNumber);
-  c->add_option("--max-depth", a.maxDepth, "Maximum path length in vertices (default 16)")->check(CLI::Range(1, 1024));
+  c->add_option("--max-depth", a.maxDepth, "Maximum path length in vertices (default 16)")->check(rangeOf(limits::kMaxDepth));
   c->add_option("--resolution", a.resolution, "Image size WxH (overrides the scene), e.g. 640x480");
   c->add_option("--exposure", a.exposure, "PNG preview exposure in stops (the EXR is unaffected)")
-      ->check(CLI::Range(-64.0f, 64.0f));
+      ->check(rangeOf(limits::kExposure));
   c->add_option("-t,--threads", a.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
   c->add_flag("-q,--quiet", a.quiet, "No progress bar and no summary");
   c->add_flag("--stats", a.stats,
@@ -181,18 +197,18 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
               "photon-pass and render seconds, estimate counts and samples per pixel (also with --quiet)");
   const std::string photonGroup = "Photon methods (static, accumulation, standard, time)";
   c->add_option("--photons", a.photons, "Caustic photons to store (default 200000)")
-      ->check(CLI::Range(int64_t(0), int64_t(1) << 31))->group(photonGroup);
+      ->check(rangeOf(limits::kPhotons))->group(photonGroup);
   c->add_option("--global-photons", a.globalPhotons, "Global photons to store (default 50000)")
-      ->check(CLI::Range(int64_t(0), int64_t(1) << 31))->group(photonGroup);
+      ->check(rangeOf(limits::kPhotons))->group(photonGroup);
   c->add_option("--frames", a.frames, "accumulation: in-between frames, each with 1/N of the photons and of the samples (default 8)")
-      ->check(CLI::Range(1, 4096))->group(photonGroup);
+      ->check(rangeOf(limits::kFrames))->group(photonGroup);
   c->add_option("--search", a.search, "time: twopass (space, then time) or 4d (space-time kd-tree) (default twopass)")
       ->check(CLI::IsMember({"twopass", "4d"}))->group(photonGroup);
   c->add_option("--k", a.k, "Photons in the spatial search: k for standard and 4d, k_s for twopass (default 100)")
-      ->check(CLI::Range(1, 4096))->group(photonGroup);
+      ->check(rangeOf(limits::kK))->group(photonGroup);
   c->add_option("--fraction", a.fraction, "twopass: fraction of the k_s kept nearest in time (default 0.5)")
-      ->check(CLI::Range(1e-6f, 1.0f))->group(photonGroup);
-  c->add_option("--kappa", a.kappa, "4d: weight of time in the metric d^2 = |dx|^2 + kappa dt^2 (default 1)")
+      ->check(rangeOf(limits::kFraction))->group(photonGroup);
+  c->add_option("--kappa", a.kappa, "4d: weight of time in the metric d^2 = |dx|^2 + kappa dt^2 (default 1; for a 1 s shutter at least 7.7e-34 and at most 8.5e37, see docs/scene-format.md)")
       ->check(CLI::PositiveNumber)->group(photonGroup);
   c->add_option("--max-radius", a.maxRadius, "Largest search radius, scene units (default 2% of the scene's diagonal)")
       ->check(CLI::PositiveNumber)->group(photonGroup);
@@ -203,7 +219,7 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_option("--kernel-time", a.kernelTime, "Time kernel: uniform, epanechnikov (default uniform)")
       ->check(CLI::IsMember({"uniform", "epanechnikov"}))->group(photonGroup);
   c->add_option("--gather", a.gather, "Final-gather rays per sample for indirect light; 0: none (default 1)")
-      ->check(CLI::Range(0, 1024))->group(photonGroup);
+      ->check(rangeOf(limits::kGather))->group(photonGroup);
   c->add_flag("--global-direct", a.globalDirect, "Show the global photon map directly at the first diffuse hit (debugging, tests)")
       ->group(photonGroup);
   return c;
@@ -219,6 +235,17 @@ int runRender(const RenderArgs& a) {
   validateOutput(output);
 
   scene::SceneDescription desc = scene::loadScene(a.scene);
+  if (a.kappa) {
+    // The usable kappa depends on the scene's shutter (scene/limits.h).
+    limits::KappaRange r = limits::kappaRange(double(desc.camera.shutterClose) - desc.camera.shutterOpen);
+    if (!(*a.kappa >= r.lo && *a.kappa <= r.hi)) {
+      char msg[200];
+      std::snprintf(msg, sizeof msg, "--kappa: %g cannot be used with the %g s shutter of ", double(*a.kappa),
+                    double(desc.camera.shutterClose) - desc.camera.shutterOpen);
+      throw Error(msg + a.scene + ": the 4D metric needs kappa in [" + formatG(r.lo) + ", " + formatG(r.hi) +
+                  "] (float range)");
+    }
+  }
   RenderOptions opt = mergeOptions(a, desc.render, a.scene);
   float exposure = pick(a.exposure, desc.render.exposure, 0.0f);
   if (a.resolution) {

@@ -16,6 +16,8 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "math/bounds.h"
+#include "motion/motion.h"
 #include "scene/json_locate.h"
 #include "scene/limits.h"
 #include "scene/mesh_obj.h"
@@ -48,10 +50,36 @@ Node memberOr(const Node& object, const char* key) { return object.has(key) ? ob
 
 bool isZero(Vec3f v) { return v.x == 0 && v.y == 0 && v.z == 0; }
 
-// Normalises without underflow for tiny but non-zero vectors.
+// Normalises in double, so any non-zero float vector (1e-40 or 3e38 per
+// component) gives a unit vector; float arithmetic would underflow or
+// overflow (v / m computes 1 / m, which is inf for m = 1e-40).
 Vec3f safeNormalize(Vec3f v) {
-  float m = std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)});
-  return normalize(v / m);
+  double x = v.x, y = v.y, z = v.z, len = std::sqrt(x * x + y * y + z * z);
+  return {float(x / len), float(y / len), float(z / len)};
+}
+
+// ---------------------------------------------------------------- ranges
+
+std::string coordinateRange() {
+  return "within +-" + fmt(limits::kMaxCoordinate) + " m, the range the ray tracer handles (docs/scene-format.md)";
+}
+
+bool inRange(Vec3f p) {
+  const float m = limits::kMaxCoordinate;  // false for NaN and inf too
+  return std::fabs(p.x) <= m && std::fabs(p.y) <= m && std::fabs(p.z) <= m;
+}
+
+// A point the renderer uses as given (camera, light position).
+void checkPoint(const Node& n, Vec3f p, const char* what) {
+  n.require(inRange(p), std::string(what) + " " + formatVec(p) + " is out of range: coordinates must be " + coordinateRange());
+}
+
+// A scale factor per axis (placement times keyframe), as build.cpp composes it.
+void checkScale(const Node& n, Vec3f s) {
+  for (float c : {s.x, s.y, s.z})
+    n.require(std::fabs(c) >= limits::kMinScale && std::fabs(c) <= limits::kMaxScale,
+              "scale " + formatVec(s) + " is out of range: each factor's magnitude must be in [" + fmt(limits::kMinScale) +
+                  ", " + fmt(limits::kMaxScale) + "] (the transform and its inverse must be finite)");
 }
 
 Vec3f readDirection(const Node& n) {
@@ -138,6 +166,48 @@ MotionDesc readMotion(const Node& n, Shutter s) {
   return m;
 }
 
+// ---------------------------------------------------------------- placement checks
+
+// The motion exactly as scene/build.cpp makes it (placement, keyframes,
+// resampled over the shutter), so the checks below see what the renderer will.
+Motion motionOf(const TransformDesc& placement, const MotionDesc& motion, Shutter s) {
+  if (motion.empty()) return Motion::still(placement.matrix());
+  std::vector<MotionKey> keys;
+  for (size_t i = 0; i < motion.times.size(); ++i)
+    keys.push_back({motion.times[i], motion.poses[i].translate, motion.poses[i].rotate, motion.poses[i].scale});
+  MotionKey p{0.0f, placement.translate, placement.rotate, placement.scale};
+  return Motion::keyframed(p, keys, ::tdpm::Shutter{s.open, s.close});
+}
+
+// Scale factors as composed (keyframe times placement), and no keyframe pair
+// whose linear blend passes through a zero scale.
+void checkScales(const Node& n, const TransformDesc& placement, const MotionDesc& motion) {
+  if (motion.empty()) {
+    checkScale(memberOr(memberOr(n, "transform"), "scale"), placement.scale);
+    return;
+  }
+  Node keys = n.member("motion");
+  for (size_t i = 0; i < motion.poses.size(); ++i) {
+    Node key = memberOr(keys.element(i), "scale");
+    Vec3f s = motion.poses[i].scale;
+    checkScale(key, s * placement.scale);
+    if (i == 0) continue;
+    Vec3f prev = motion.poses[i - 1].scale;
+    key.require(prev.x * s.x > 0 && prev.y * s.y > 0 && prev.z * s.z > 0,
+                "scale " + formatVec(s) + " has a sign opposite to the previous keyframe's " + formatVec(prev) +
+                    ": the object would shrink through zero size in between");
+  }
+}
+
+// World-space bounds over the shutter must stay in the supported range.
+void checkWorldBounds(const Node& n, const Bounds3f& world, const char* what) {
+  if (inRange(world.lo) && inRange(world.hi)) return;
+  Vec3f far = inRange(world.lo) ? world.hi : world.lo;
+  Node at = n.has("motion") ? n.member("motion") : memberOr(n, "transform");
+  at.fail(std::string(what) + " reaches " + formatVec(far) +
+          " in world space (after its transform and motion); coordinates must be " + coordinateRange());
+}
+
 // ---------------------------------------------------------------- camera
 
 // A look-at frame must be well defined: distinct eye and target, up not
@@ -150,6 +220,14 @@ void checkView(const Node& at, Vec3f position, Vec3f target, Vec3f up) {
   Vec3f dir = safeNormalize(target - position);
   upNode.require(length(cross(dir, safeNormalize(up))) > 1e-4f,
                  "up " + formatVec(up) + " is parallel to the view direction " + formatVec(dir));
+  checkPoint(memberOr(at, "position"), position, "camera position");
+  checkPoint(memberOr(at, "target"), target, "camera target");
+  // The camera normalises in float (scene/camera.cpp): tiny differences underflow.
+  Vec3f forward = normalize(target - position);
+  memberOr(at, "target").require(isFinite(forward), "camera target " + formatVec(target) + " is too close to the position " +
+                                                        formatVec(position) + " to give a view direction in float");
+  upNode.require(isFinite(normalize(cross(forward, up))),
+                 "up " + formatVec(up) + " is too small to give a camera frame in float");
 }
 
 void readResolution(const Node& n, CameraDesc* cam) {
@@ -167,6 +245,9 @@ void readResolution(const Node& n, CameraDesc* cam) {
 void readShutter(const Node& n, CameraDesc* cam) {
   Vec2f s = n.vec2();
   n.require(s.y >= s.x, "shutter close (" + fmt(s.y) + ") is before open (" + fmt(s.x) + ")");
+  // The renderer maps scene time to [0, 1] by (t - open) / (close - open) in float.
+  n.require(std::isfinite(s.y - s.x), "shutter [" + fmt(s.x) + ", " + fmt(s.y) +
+                                          "] is too long: its duration overflows a 32-bit float");
   cam->shutterOpen = s.x;
   cam->shutterClose = s.y;
 }
@@ -351,7 +432,10 @@ ShapeDesc readShape(const Node& n, const std::string& sceneDir) {
   if (type == "sphere") {
     n.expectObject({"type", "radius"});
     s.type = ShapeDesc::Type::Sphere;
-    if (n.has("radius")) s.radius = readPositive(n.member("radius"), "radius");
+    if (n.has("radius")) {
+      s.radius = readPositive(n.member("radius"), "radius");
+      checkPoint(n.member("radius"), Vec3f(s.radius), "radius");
+    }
   } else if (type == "quad") {
     n.expectObject({"type", "size"});
     s.type = ShapeDesc::Type::Quad;
@@ -360,6 +444,7 @@ ShapeDesc readShape(const Node& n, const std::string& sceneDir) {
       Vec2f v = sz.vec2();
       sz.require(v.x > 0 && v.y > 0, "size must be positive in every dimension, got [" + fmt(v.x) + ", " + fmt(v.y) + "]");
       s.size = {v.x, 1.0f, v.y};  // a quad spans x and z; y is unused
+      checkPoint(sz, s.size * 0.5f, "half size");
     }
   } else if (type == "box") {
     n.expectObject({"type", "size"});
@@ -369,6 +454,7 @@ ShapeDesc readShape(const Node& n, const std::string& sceneDir) {
       s.size = sz.vec3();
       sz.require(s.size.x > 0 && s.size.y > 0 && s.size.z > 0,
                  "size must be positive in every dimension, got " + formatVec(s.size));
+      checkPoint(sz, s.size * 0.5f, "half size");
     }
   } else {
     n.expectObject({"type", "file"});
@@ -379,6 +465,18 @@ ShapeDesc readShape(const Node& n, const std::string& sceneDir) {
 }
 
 // ---------------------------------------------------------------- objects
+
+// Object-space bounds, as scene/build.cpp computes them.
+Bounds3f objectBounds(const ShapeDesc& shape) {
+  Bounds3f b;
+  switch (shape.type) {
+    case ShapeDesc::Type::Sphere: b.extend(Vec3f(-shape.radius)); b.extend(Vec3f(shape.radius)); break;
+    case ShapeDesc::Type::Quad: b.extend({-0.5f * shape.size.x, 0, -0.5f * shape.size.z}); b.extend({0.5f * shape.size.x, 0, 0.5f * shape.size.z}); break;
+    case ShapeDesc::Type::Box: b.extend(shape.size * -0.5f); b.extend(shape.size * 0.5f); break;
+    case ShapeDesc::Type::Mesh: for (Vec3f v : shape.vertices) b.extend(v); break;
+  }
+  return b;
+}
 
 std::string readName(const Node& n, const std::string& fallback) {
   if (!n.has("name")) return fallback;
@@ -396,6 +494,8 @@ ObjectDesc readObject(const Node& n, std::vector<MaterialDesc>* materials, Shutt
   o.material = resolveMaterial(n, materials);
   if (n.has("transform")) o.placement = readTransform(n.member("transform"));
   if (n.has("motion")) o.motion = readMotion(n.member("motion"), s);
+  checkScales(n, o.placement, o.motion);
+  checkWorldBounds(n, motionOf(o.placement, o.motion, s).sweptBounds(objectBounds(o.shape)), "the object");
   return o;
 }
 
@@ -423,6 +523,7 @@ void readSpot(const Node& n, LightDesc* l) {
     Node t = n.member("target");
     Vec3f target = t.vec3();
     t.require(!isZero(target - l->position), "spot target equals its position " + formatVec(target));
+    checkPoint(t, target, "target");
     l->direction = safeNormalize(target - l->position);
   }
   if (n.has("direction")) l->direction = readDirection(n.member("direction"));
@@ -447,6 +548,29 @@ void readAreaSize(const Node& n, LightDesc* l) {
   l->areaSize = v;
 }
 
+// Where the renderer will put the light over the shutter (scene/build.cpp,
+// scene/light.cpp): in range, and an area light with a non-zero float area.
+void checkLightPlacement(const Node& n, const LightDesc& l, Shutter s) {
+  if (l.type == LightDesc::Type::Directional) return;  // a direction only
+  checkScales(n, l.placement, l.motion);
+  Motion m = motionOf(l.placement, l.motion, s);
+  Bounds3f world;
+  if (l.type != LightDesc::Type::Area) {
+    for (int i = 0; i < m.stepCount(); ++i) world.extend(m.step(i).point(l.position));
+    checkWorldBounds(n, world, "the light");
+    return;
+  }
+  Bounds3f local;
+  local.extend({-0.5f * l.areaSize.x, 0, -0.5f * l.areaSize.y});
+  local.extend({0.5f * l.areaSize.x, 0, 0.5f * l.areaSize.y});
+  checkWorldBounds(n, m.sweptBounds(local), "the light");
+  for (int i = 0; i < m.stepCount(); ++i) {
+    float area = length(cross(m.step(i).vector({0, 0, l.areaSize.y}), m.step(i).vector({l.areaSize.x, 0, 0})));
+    memberOr(n, "size").require(area > 1e-30f && std::isfinite(area),
+                                "the light's area " + fmt(area) + " m^2 (after its transform) is too small for float arithmetic");
+  }
+}
+
 LightDesc readLight(const Node& n, Shutter s) {
   n.requireObject();
   std::vector<std::string> names;
@@ -465,23 +589,47 @@ LightDesc readLight(const Node& n, Shutter s) {
   l.name = readName(n, n.path());
   if (n.has("power")) l.power = n.member("power").color();
   if (n.has("irradiance")) l.power = n.member("irradiance").color();
-  if (n.has("position")) l.position = n.member("position").vec3();
+  if (n.has("position")) {
+    l.position = n.member("position").vec3();
+    checkPoint(n.member("position"), l.position, "position");
+  }
   if (kind.type == LightDesc::Type::Directional && n.has("direction"))
     l.direction = readDirection(n.member("direction"));
   if (kind.type == LightDesc::Type::Spot) readSpot(n, &l);
   if (n.has("size")) readAreaSize(n.member("size"), &l);
   if (n.has("transform")) l.placement = readTransform(n.member("transform"));
   if (n.has("motion")) l.motion = readMotion(n.member("motion"), s);
+  checkLightPlacement(n, l, s);
   return l;
 }
 
 // ---------------------------------------------------------------- render
 
-int readCount(const Node& n, const char* what) {
+// A count whose range the matching flag shares (scene/limits.h).
+int64_t readInRange(const Node& n, const char* what, limits::IntRange r) {
   int64_t v = n.integer();
-  n.require(v >= 1, std::string(what) + " must be at least 1, got " + std::to_string(v));
-  n.require(v <= INT_MAX, std::string(what) + " " + std::to_string(v) + " is too large");
-  return int(v);
+  n.require(v >= r.lo, std::string(what) + " must be at least " + std::to_string(r.lo) + ", got " + std::to_string(v));
+  n.require(v <= r.hi, std::string(what) + " " + std::to_string(v) + " is too large (at most " + std::to_string(r.hi) + ")");
+  return v;
+}
+
+int readCount(const Node& n, const char* what, limits::IntRange r) { return int(readInRange(n, what, r)); }
+
+float readFloatInRange(const Node& n, const char* what, limits::FloatRange r) {
+  float v = n.number();
+  n.require(v >= r.lo && v <= r.hi, std::string(what) + " must be in [" + fmt(r.lo) + ", " + fmt(r.hi) + "], got " + fmt(v));
+  return v;
+}
+
+// kappa weighs time against space in a float metric: refuse what it cannot
+// compute for this shutter (scene/limits.h).
+float readKappa(const Node& n, float shutterLength) {
+  float kappa = readPositive(n, "kappa");
+  limits::KappaRange r = limits::kappaRange(shutterLength);
+  n.require(kappa >= r.lo && kappa <= r.hi, "kappa " + fmt(kappa) + " cannot be used with a shutter of " +
+                                                fmt(shutterLength) + " s: the 4D metric needs kappa in [" + fmt(r.lo) +
+                                                ", " + fmt(r.hi) + "] (float range)");
+  return kappa;
 }
 
 uint64_t readSeed(const Node& n) {
@@ -500,48 +648,30 @@ const std::vector<std::string> kSearches = {"twopass", "4d"};
 const std::vector<std::string> kSpaceKernels = {"uniform", "cone", "epanechnikov"};
 const std::vector<std::string> kTimeKernels = {"uniform", "epanechnikov"};
 
-int64_t readPhotonCount(const Node& n, const char* what) {
-  int64_t v = n.integer();
-  n.require(v >= 0, std::string(what) + " must be at least 0, got " + std::to_string(v));
-  // 2^31 photons at 20 bytes is 40 GiB: more is certainly a typo.
-  n.require(v <= (int64_t(1) << 31), std::string(what) + " " + std::to_string(v) + " is too large (at most 2^31)");
-  return v;
-}
-
-RenderSettings readRender(const Node& n) {
+RenderSettings readRender(const Node& n, float shutterLength) {
   n.expectObject({"method", "spp", "max_spp", "contrast", "seed", "max_depth", "exposure", "photons", "global_photons",
                   "frames", "search", "k", "fraction", "kappa", "max_radius", "max_dt", "kernel_space", "kernel_time",
                   "gather"});
   RenderSettings r;
   if (n.has("method")) r.method = n.member("method").choice(kMethods, "render method");
-  if (n.has("spp")) r.spp = readCount(n.member("spp"), "spp");
-  if (n.has("max_spp")) r.maxSpp = readCount(n.member("max_spp"), "max_spp");
+  if (n.has("spp")) r.spp = readCount(n.member("spp"), "spp", limits::kSpp);
+  if (n.has("max_spp")) r.maxSpp = readCount(n.member("max_spp"), "max_spp", limits::kSpp);
   if (n.has("contrast")) r.contrast = readPositive(n.member("contrast"), "contrast");
   if (n.has("seed")) r.seed = readSeed(n.member("seed"));
-  if (n.has("max_depth")) r.maxDepth = readCount(n.member("max_depth"), "max_depth");
-  if (n.has("exposure")) r.exposure = n.member("exposure").number();
-  if (n.has("photons")) r.photons = readPhotonCount(n.member("photons"), "photons");
-  if (n.has("global_photons")) r.globalPhotons = readPhotonCount(n.member("global_photons"), "global_photons");
-  if (n.has("frames")) r.frames = readCount(n.member("frames"), "frames");
+  if (n.has("max_depth")) r.maxDepth = readCount(n.member("max_depth"), "max_depth", limits::kMaxDepth);
+  if (n.has("exposure")) r.exposure = readFloatInRange(n.member("exposure"), "exposure", limits::kExposure);
+  if (n.has("photons")) r.photons = readInRange(n.member("photons"), "photons", limits::kPhotons);
+  if (n.has("global_photons")) r.globalPhotons = readInRange(n.member("global_photons"), "global_photons", limits::kPhotons);
+  if (n.has("frames")) r.frames = readCount(n.member("frames"), "frames", limits::kFrames);
   if (n.has("search")) r.search = n.member("search").choice(kSearches, "search");
-  if (n.has("k")) r.k = readCount(n.member("k"), "k");
-  if (n.has("fraction")) {
-    const Node f = n.member("fraction");
-    float v = f.number();
-    f.require(v > 0 && v <= 1, "fraction must be in (0, 1], got " + f.json().dump());
-    r.fraction = v;
-  }
-  if (n.has("kappa")) r.kappa = readPositive(n.member("kappa"), "kappa");
+  if (n.has("k")) r.k = readCount(n.member("k"), "k", limits::kK);
+  if (n.has("fraction")) r.fraction = readFloatInRange(n.member("fraction"), "fraction", limits::kFraction);
+  if (n.has("kappa")) r.kappa = readKappa(n.member("kappa"), shutterLength);
   if (n.has("max_radius")) r.maxRadius = readPositive(n.member("max_radius"), "max_radius");
   if (n.has("max_dt")) r.maxDt = readPositive(n.member("max_dt"), "max_dt");
   if (n.has("kernel_space")) r.kernelSpace = n.member("kernel_space").choice(kSpaceKernels, "space kernel");
   if (n.has("kernel_time")) r.kernelTime = n.member("kernel_time").choice(kTimeKernels, "time kernel");
-  if (n.has("gather")) {
-    const Node g = n.member("gather");
-    int64_t v = g.integer();
-    g.require(v >= 0 && v <= 1024, "gather must be in [0, 1024], got " + std::to_string(v));
-    r.gather = int(v);
-  }
+  if (n.has("gather")) r.gather = readCount(n.member("gather"), "gather", limits::kGather);
   return r;
 }
 
@@ -565,7 +695,7 @@ SceneDescription readScene(const Node& root, const std::string& sourcePath) {
     for (size_t i = 0; i < n; ++i) scene.lights.push_back(readLight(lights.element(i), shutter));
   }
   if (root.has("background")) scene.background = root.member("background").color();
-  if (root.has("render")) scene.render = readRender(root.member("render"));
+  if (root.has("render")) scene.render = readRender(root.member("render"), shutter.close - shutter.open);
   return scene;
 }
 
