@@ -567,10 +567,10 @@ TEST_CASE("scene parse: mesh errors name the mesh file and the JSON path") {
     return errorOf(j.dump(), kData + "/inline.json");
   };
   std::string prefix = kData + "/inline.json:1: objects[0].shape.file: mesh \"" + kData + "/meshes/";
-  CHECK(meshError("bad_index.obj") == prefix + "bad_index.obj\": face 2 uses vertex 9 but the file has 3 vertices");
+  CHECK(meshError("bad_index.obj") == prefix + "bad_index.obj\", line 6: face 2 uses vertex 9 but the file has 3 vertices");
   CHECK(meshError("no_faces.obj") == prefix + "no_faces.obj\" has no triangles");
-  CHECK(meshError("nonfinite.obj") == prefix + "nonfinite.obj\": vertex 2 is not finite");
-  CHECK(meshError("two_corners.obj") == prefix + "two_corners.obj\": has a face with fewer than 3 vertices");
+  CHECK(meshError("nonfinite.obj") == prefix + "nonfinite.obj\", line 3: number 1e999 is not finite as a 32-bit float");
+  CHECK(meshError("two_corners.obj") == prefix + "two_corners.obj\", line 5: a face needs at least 3 vertices, got 2");
   CHECK(meshError("") == prefix + "\" is not a regular file");
   checkEdit([](Json& s) { s["objects"][0]["shape"] = {{"type", "mesh"}, {"file", ""}}; }, "objects[0].shape.file",
             "mesh file name must not be empty");
