@@ -43,6 +43,12 @@ struct Shutter {
 };
 
 std::string fmt(double v) { return formatNumber(v); }
+// 3 significant digits, for computed bounds.
+std::string fmt3(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
 
 // The member if present, else the object: where to point an error about a
 // value that may have come from a default.
@@ -627,8 +633,8 @@ float readKappa(const Node& n, float shutterLength) {
   float kappa = readPositive(n, "kappa");
   limits::KappaRange r = limits::kappaRange(shutterLength);
   n.require(kappa >= r.lo && kappa <= r.hi, "kappa " + fmt(kappa) + " cannot be used with a shutter of " +
-                                                fmt(shutterLength) + " s: the 4D metric needs kappa in [" + fmt(r.lo) +
-                                                ", " + fmt(r.hi) + "] (float range)");
+                                                fmt(shutterLength) + " s: the 4D metric needs kappa in [" + fmt3(r.lo) +
+                                                ", " + fmt3(r.hi) + "] (float range)");
   return kappa;
 }
 
