@@ -11,7 +11,7 @@
 #                                        # fixed number of inputs, so CI does not fail by
 #                                        # luck and a failure replays
 #
-# Seeds: scenes/*.json and tests/data/*.json for fuzz_scene; fuzz/corpus/exr/
+# Seeds: scenes/*.json, tests/data/*.json and fuzz/corpus/scene/ for fuzz_scene; fuzz/corpus/exr/
 # (small EXRs written by tdpm or oiiotool, plus every input a run ever
 # failed on, named regress-*) for fuzz_exr. The corpus copies grown by a
 # run are thrown away: the seeds in git stay small and reviewed.
@@ -48,7 +48,7 @@ echo "fuzz.sh: build took $(( $(date +%s) - start )) s"
 work=build-fuzz/run
 rm -rf "$work"
 mkdir -p "$work/scene" "$work/exr"
-cp scenes/*.json tests/data/*.json "$work/scene/" 2>/dev/null || true
+cp scenes/*.json tests/data/*.json fuzz/corpus/scene/*.json "$work/scene/" 2>/dev/null || true
 cp fuzz/corpus/exr/*.exr "$work/exr/"
 
 status=0
@@ -56,10 +56,12 @@ for target in scene exr; do
   findings=build-fuzz/findings/$target
   mkdir -p "$findings"
   log=build-fuzz/fuzz_$target.log
+  # Scenes up to 64 KB, so deep (item 7) and wide (item 8) inputs are reachable.
+  max_len=""; [ "$target" = scene ] && max_len="-max_len=65536"
   # -timeout: one input taking over 10 s is a hang; -rss_limit_mb: a
   # runaway allocation is a finding too. ASan's leak check stays on.
   if build-fuzz/fuzz/fuzz_$target "$work/$target" -seed="$seed" -runs="$runs" -max_total_time="$seconds" \
-       -timeout=10 -rss_limit_mb=2048 -artifact_prefix="$findings/" -print_final_stats=1 >"$log" 2>&1; then
+       -timeout=10 -rss_limit_mb=2048 $max_len -artifact_prefix="$findings/" -print_final_stats=1 >"$log" 2>&1; then
     done_runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')
     cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*' || echo '?')
     secs=$(grep -o 'Done [0-9]* runs in [0-9]* second' "$log" | grep -o 'in [0-9]*' | grep -o '[0-9]*' || echo "$seconds")
