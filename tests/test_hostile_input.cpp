@@ -171,6 +171,8 @@ TEST_CASE("hostile input: scene render keys have the flags' ranges, named by JSO
   checkEdit([](Json& j) { j["render"] = {{"exposure", 65}}; }, "render.exposure", "exposure must be in [-64, 64], got 65");
   checkEdit([](Json& j) { j["render"] = {{"photons", 3e9}}; }, "render.photons",
             "photons 3000000000 is too large (at most 2147483648)");
+  checkEdit([](Json& j) { j["render"] = {{"max_radius", 1e-30}}; }, "render.max_radius",
+            "max_radius must be in [1.1e-19, 1.8e+19], got 1e-30");
 
   // The command line refuses the same values with the same bounds.
   test::CommandResult k = test::runTdpm("render x.json --k 4097");
@@ -180,6 +182,9 @@ TEST_CASE("hostile input: scene render keys have the flags' ranges, named by JSO
   CHECK(frames.output.find("not in range 1 to 4096") != std::string::npos);
   test::CommandResult depth = test::runTdpm("render x.json --max-depth 1025");
   CHECK(depth.output.find("not in range 1 to 1024") != std::string::npos);
+  test::CommandResult radius = test::runTdpm("render x.json --max-radius 1e-30");
+  CHECK(radius.exitCode != 0);
+  CHECK(radius.output.find("--max-radius") != std::string::npos);
 }
 
 // ============================================================ kappa (item 6)
@@ -329,6 +334,17 @@ TEST_CASE("hostile input: derived quantities are validated as the renderer compu
   checkEdit([](Json& j) { j["camera"]["up"] = {1e-30, 0, 0}; }, "camera.up", "is too small to give a camera frame in float");
   checkEdit([](Json& j) { j["lights"][0] = Json::parse(R"({"type": "area", "size": [1e-20, 1e-20]})"); }, "lights[0].size",
             "is too small for float arithmetic");
+  checkEdit(
+      [](Json& j) {
+        j["objects"][0]["motion"] = Json::parse(R"([{"time": 0}, {"time": 1e-30, "rotate": {"axis": [0, 1, 0], "angle": 90}}])");
+      },
+      "objects[0].motion[1].time", "keyframes must be at least 1e-06 of the shutter apart");
+  checkEdit(
+      [](Json& j) {
+        j["materials"] = Json::parse(R"({"c": {"type": "diffuse", "texture": {"type": "checker", "scale": 1e-40}}})");
+        j["objects"][0]["material"] = "c";
+      },
+      "materials.c.texture.scale", "checker scale 9.99995e-41 is too small (1 / scale overflows)");
 }
 
 // ============================================================ OBJ files that lie (item 5)

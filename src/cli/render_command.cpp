@@ -30,15 +30,26 @@ namespace {
 namespace limits = scene::limits;
 static_assert(limits::kTimeBins == photon::kTimeBins, "the kappa range in scene/limits.h assumes the photon time bins");
 
-template <class R>
-CLI::Range rangeOf(R r) {
-  return CLI::Range(r.lo, r.hi);
-}
-
 std::string formatG(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3g", v);
   return buf;
+}
+
+CLI::Range rangeOf(limits::IntRange r) { return CLI::Range(r.lo, r.hi); }
+
+// CLI::Range prints float bounds as "0.000000": say 1.1e-19 instead.
+CLI::Validator rangeOf(limits::FloatRange r) {
+  std::string range = formatG(r.lo) + " to " + formatG(r.hi);
+  return CLI::Validator(
+      [r, range](std::string& text) -> std::string {
+        char* end = nullptr;
+        double v = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0') return "expected a number, got '" + text + "'";
+        if (!(v >= r.lo && v <= r.hi)) return "Value " + text + " not in range " + range;
+        return "";
+      },
+      "FLOAT in [" + range + "]");
 }
 
 std::string methodList() {
@@ -211,7 +222,7 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_option("--kappa", a.kappa, "4d: weight of time in the metric d^2 = |dx|^2 + kappa dt^2 (default 1; for a 1 s shutter at least 7.7e-34 and at most 8.5e37, see docs/scene-format.md)")
       ->check(CLI::PositiveNumber)->group(photonGroup);
   c->add_option("--max-radius", a.maxRadius, "Largest search radius, scene units (default 2% of the scene's diagonal)")
-      ->check(CLI::PositiveNumber)->group(photonGroup);
+      ->check(rangeOf(limits::kMaxRadius))->group(photonGroup);
   c->add_option("--max-dt", a.maxDt, "twopass: largest time distance kept, seconds (default: none)")
       ->check(CLI::PositiveNumber)->group(photonGroup);
   c->add_option("--kernel-space", a.kernelSpace, "Space kernel: uniform, cone, epanechnikov (default uniform)")

@@ -40,6 +40,11 @@ constexpr float kMaxCoordinate = 1e9f;
 constexpr float kMinScale = 1e-12f;
 constexpr float kMaxScale = 1e12f;
 
+// Consecutive keyframes at least this fraction of the shutter apart: the
+// step count divides a pair's rotation angle by its share of the shutter
+// and must fit an int (motion/motion.cpp); 1e-6 leaves a factor 40 margin.
+constexpr float kMinKeyframeGap = 1e-6f;
+
 // ---- render settings: the flag and the scene key share one range
 struct IntRange {
   int64_t lo, hi;
@@ -57,6 +62,8 @@ struct FloatRange {
 };
 constexpr FloatRange kFraction{1e-6f, 1.0f};
 constexpr FloatRange kExposure{-64.0f, 64.0f};
+// The estimators square it in float: r^2 must be a normal, finite float.
+constexpr FloatRange kMaxRadius{1.1e-19f, 1.8e19f};
 
 // ---- the 4D metric d^2 = |dx|^2 + kappa dt^2
 // The 4D kd-tree keys time as sqrt(kappa) t in float and resolves it to one

@@ -155,6 +155,12 @@ float readKeyTime(const Node& key, size_t index, float previous, Shutter s) {
             "keyframe times must be strictly increasing: " + fmt(time) + " does not come after " + fmt(previous));
   t.require(time >= s.open && time <= s.close,
             "time " + fmt(time) + " is outside the shutter [" + fmt(s.open) + ", " + fmt(s.close) + "]");
+  // motion/motion.cpp divides a keyframe pair's rotation by its share of the
+  // shutter (to choose the step count, an int): shares below ~4e-8 overflow it.
+  float gap = limits::kMinKeyframeGap * (s.close - s.open);
+  t.require(index == 0 || time - previous >= gap,
+            "keyframe time " + fmt(time) + " is too close to the previous one (" + fmt(previous) +
+                "): keyframes must be at least " + fmt(limits::kMinKeyframeGap) + " of the shutter apart");
   return time;
 }
 
@@ -315,7 +321,11 @@ TextureDesc readTexture(const Node& n) {
     t.color = readReflectance(c.element(0));
     t.color2 = readReflectance(c.element(1));
   }
-  if (n.has("scale")) t.scale = readPositive(n.member("scale"), "checker scale (cell size)");
+  if (n.has("scale")) {
+    t.scale = readPositive(n.member("scale"), "checker scale (cell size)");
+    // The renderer multiplies by 1 / scale (scene/build.cpp).
+    n.member("scale").require(std::isfinite(1.0f / t.scale), "checker scale " + fmt(t.scale) + " is too small (1 / scale overflows)");
+  }
   return t;
 }
 
@@ -673,7 +683,7 @@ RenderSettings readRender(const Node& n, float shutterLength) {
   if (n.has("k")) r.k = readCount(n.member("k"), "k", limits::kK);
   if (n.has("fraction")) r.fraction = readFloatInRange(n.member("fraction"), "fraction", limits::kFraction);
   if (n.has("kappa")) r.kappa = readKappa(n.member("kappa"), shutterLength);
-  if (n.has("max_radius")) r.maxRadius = readPositive(n.member("max_radius"), "max_radius");
+  if (n.has("max_radius")) r.maxRadius = readFloatInRange(n.member("max_radius"), "max_radius", limits::kMaxRadius);
   if (n.has("max_dt")) r.maxDt = readPositive(n.member("max_dt"), "max_dt");
   if (n.has("kernel_space")) r.kernelSpace = n.member("kernel_space").choice(kSpaceKernels, "space kernel");
   if (n.has("kernel_time")) r.kernelTime = n.member("kernel_time").choice(kTimeKernels, "time kernel");
