@@ -86,6 +86,12 @@ bool isSymlink(const std::string& path) {
   return ::lstat(path.c_str(), &st) == 0 && S_ISLNK(st.st_mode);
 }
 
+// A forked test child's messages would clutter the test log.
+void quietChild() {
+  int fd = ::open("/dev/null", O_WRONLY);
+  if (fd >= 0) ::dup2(fd, STDERR_FILENO);
+}
+
 // Writes `text` through AtomicFile's temporary, as the image writers do.
 void fill(const AtomicFile& f, const std::string& text) { test::writeFile(f.tempPath(), text); }
 
@@ -351,6 +357,7 @@ TEST_CASE("output safety: a signal removes registered temporaries and ends the p
   pid_t pid = ::fork();
   REQUIRE(pid >= 0);
   if (pid == 0) {
+    quietChild();
     ::close(pipeFd[0]);
     signals::install(signals::Mode::Exit);
     AtomicFile f(dir + "/x.exr");
@@ -376,6 +383,7 @@ TEST_CASE("output safety: in stop mode the first signal only asks to stop, the s
   pid_t pid = ::fork();
   REQUIRE(pid >= 0);
   if (pid == 0) {
+    quietChild();
     signals::install(signals::Mode::Stop);
     if (signals::stopRequested() != 0) ::_exit(20);
     ::raise(SIGINT);
@@ -393,6 +401,7 @@ TEST_CASE("output safety: a deferred signal acts when the deferral ends") {
   pid_t pid = ::fork();
   REQUIRE(pid >= 0);
   if (pid == 0) {
+    quietChild();
     signals::install(signals::Mode::Exit);
     {
       signals::Deferral d;
