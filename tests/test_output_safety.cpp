@@ -317,6 +317,11 @@ TEST_CASE("output safety: a symbolic link is written through, keeping its target
   REQUIRE(::chmod(target.c_str(), 0600) == 0);
   writeTextFileAtomic(target, "newer");
   CHECK(modeOf(target) == 0600);
+  // A read-only one too (its mode is applied at commit, after the writer).
+  REQUIRE(::chmod(target.c_str(), 0444) == 0);
+  writeTextFileAtomic(target, "newest");
+  CHECK(readAll(target) == "newest");
+  CHECK(modeOf(target) == 0444);
 
   // A dangling link is refused, naming where it points.
   REQUIRE(::symlink("nowhere/x.txt", (dir + "/dangling.txt").c_str()) == 0);

@@ -201,14 +201,15 @@ std::vector<std::string> accumulationSppWarnings(const RenderOptions& o, bool ha
 
 // After the render: every frame's photon pass emits at least one batch of
 // paths, so many frames with few photons each store more than asked.
-void warnAccumulationPhotons(const RenderOptions& o, const RenderStats& st) {
+void warnAccumulationPhotons(const RenderOptions& o, bool hasMotion, const RenderStats& st) {
   if (o.method != "accumulation") return;
+  const int frames = hasMotion ? std::max(1, o.frames) : 1;
   auto check = [&](const char* kind, size_t asked, size_t stored) {
     if (asked > 0 && double(stored) > 1.1 * double(asked))
       std::fprintf(stderr,
                    "tdpm: warning: accumulation: %s %s photons stored, not the %s asked for: each of the %d frames "
-                   "traces at least one batch of photon paths (use fewer --frames or more photons)\n",
-                   formatCount(stored).c_str(), kind, formatCount(asked).c_str(), o.frames);
+                   "traces at least one batch of photon paths (fewer --frames or more photons avoid it)\n",
+                   formatCount(stored).c_str(), kind, formatCount(asked).c_str(), frames);
   };
   check("caustic", o.causticPhotons, st.causticStored);
   check("global", o.globalPhotons, st.globalStored);
@@ -307,7 +308,7 @@ int runRender(const RenderArgs& a) {
   Film film = render(*scene, opt, bar.progress(), stats);
   bar.finish();
   for (const std::string& w : stats.warnings) std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
-  warnAccumulationPhotons(opt, stats);
+  warnAccumulationPhotons(opt, scene->hasMotion, stats);
 
   const int filmWidth = film.width, filmHeight = film.height;
   image::ExrFile exr = filmToExr(std::move(film));  // moved: the write path holds no second film

@@ -107,7 +107,7 @@ AtomicFile::AtomicFile(std::string target) : target_(std::move(target)) {
   // The target must be something rename can replace: rename would fail
   // only at the very end, after all the work.
   struct stat st;
-  bool exists = resolveTarget(target_, final_, st);
+  resolveTarget(target_, final_, st);
   splitPath(final_, dir, name);
   const size_t limit = checkLength();
 
@@ -120,14 +120,6 @@ AtomicFile::AtomicFile(std::string target) : target_(std::move(target)) {
     int fd = ::open(candidate.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd >= 0) {
       signals::addTemporary(candidate.c_str());
-      if (exists) {
-        if (::geteuid() == 0 && ::fchown(fd, st.st_uid, st.st_gid) != 0) {
-          // Best effort: the content matters more than the owner.
-        }
-        if (::fchmod(fd, st.st_mode & 07777) != 0) {
-          // Best effort, as for the owner.
-        }
-      }
       ::close(fd);
       temp_ = std::move(candidate);
       return;
@@ -158,6 +150,17 @@ void AtomicFile::sync() const {
   }
   int rc = ::fsync(fd);
   int err = errno;
+  // The replaced file's mode (and owner, if we may) carry over. Set only
+  // now: a read-only mode on the temporary would stop its writer.
+  struct stat old;
+  if (::stat(final_.c_str(), &old) == 0 && S_ISREG(old.st_mode)) {
+    if (::geteuid() == 0 && (old.st_uid != 0 || old.st_gid != 0) && ::fchown(fd, old.st_uid, old.st_gid) != 0) {
+      // Best effort: the content matters more than the owner.
+    }
+    if (::fchmod(fd, old.st_mode & 07777) != 0) {
+      // Best effort, as for the owner.
+    }
+  }
   ::close(fd);
   if (rc != 0 && err != EINVAL && err != EROFS)  // EINVAL/EROFS: no fsync on this file system
     throw Error(target_ + ": cannot flush the finished file to disk: " + osReason(err));
