@@ -5,6 +5,7 @@
 // inputs), symbolic links are written through keeping the target's mode,
 // SIGINT/SIGTERM remove temporaries, the memory pre-flight names the
 // resolution, and accumulation says when frames raise its budget.
+#include <dirent.h>
 #include <doctest/doctest.h>
 #include <fcntl.h>
 #include <signal.h>
@@ -64,15 +65,13 @@ std::string readAll(const std::string& path) {
 // Names in `dir` that look like our temporaries.
 std::vector<std::string> temporariesIn(const std::string& dir) {
   std::vector<std::string> found;
-  std::string cmd = "ls -A '" + dir + "'";
-  FILE* p = popen(cmd.c_str(), "r");
-  char line[4096];
-  while (p && fgets(line, sizeof line, p)) {
-    std::string name(line);
-    if (!name.empty() && name.back() == '\n') name.pop_back();
-    if (contains(name, ".tmp.")) found.push_back(name);
+  DIR* d = ::opendir(dir.c_str());
+  while (d) {
+    const dirent* e = ::readdir(d);
+    if (!e) break;
+    if (contains(e->d_name, ".tmp.")) found.push_back(e->d_name);
   }
-  if (p) pclose(p);
+  if (d) ::closedir(d);
   return found;
 }
 
@@ -84,6 +83,19 @@ mode_t modeOf(const std::string& path) {
 bool isSymlink(const std::string& path) {
   struct stat st;
   return ::lstat(path.c_str(), &st) == 0 && S_ISLNK(st.st_mode);
+}
+
+// Waits (at most ~10 s) until process `pid` has a handler for `signo`
+// (the SigCgt mask in /proc), so a signal sent after this meets tdpm's
+// handler and not the default action, however slowly the child started.
+void waitUntilCatching(pid_t pid, int signo) {
+  for (int i = 0; i < 1000; ++i) {
+    std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+    std::string line;
+    while (std::getline(in, line))
+      if (line.rfind("SigCgt:", 0) == 0 && (std::stoull(line.substr(7), nullptr, 16) >> (signo - 1)) & 1) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
 }
 
 // A forked test child's messages would clutter the test log.
@@ -428,7 +440,7 @@ TEST_CASE("output safety: a deferred signal acts when the deferral ends") {
 TEST_CASE("output safety: SIGINT during `tdpm render` leaves no temporary and never a broken pair") {
   OldPair old;
   int interrupted = 0;
-  for (int delayMs : {300, 600, 900, 1200}) {
+  for (int delayMs : {100, 400, 700, 1000}) {
     const std::string log = old.dir + "/log.txt";
     pid_t pid = ::fork();
     REQUIRE(pid >= 0);
@@ -440,6 +452,7 @@ TEST_CASE("output safety: SIGINT during `tdpm render` leaves no temporary and ne
               "--seed", "3", "-o", old.exr.c_str(), static_cast<char*>(nullptr));
       ::_exit(127);
     }
+    waitUntilCatching(pid, SIGINT);
     std::this_thread::sleep_for(std::chrono::milliseconds(delayMs));
     ::kill(pid, SIGINT);
     int status = 0;
@@ -459,6 +472,54 @@ TEST_CASE("output safety: SIGINT during `tdpm render` leaves no temporary and ne
     }
   }
   CHECK(interrupted >= 1);
+}
+
+// SIGINT as soon as a temporary with content appears, i.e. while the pair
+// is being written: no temporary remains, and the pair is either the old
+// one (the process died by SIGINT) or the new one (it had finished).
+TEST_CASE("output safety: SIGINT while the pair is written leaves the old pair or the new one, no temporary") {
+  const std::string dir = test::makeTempDir();
+  test::writeFile(dir + "/e.json", R"({"camera": {"position": [0, 0, 4], "target": [0, 0, 0]},
+    "materials": {}, "objects": [], "lights": [], "background": 0.25, "render": {"method": "pathtrace", "spp": 1}})");
+  const std::string exr = dir + "/r.exr", png = dir + "/r.png";
+  const std::string common = "render '" + dir + "/e.json' -q -t 1 --resolution 1200x900 -o '" + exr + "'";
+  REQUIRE(runTdpm(common + " --seed 1").exitCode == 0);
+  const std::string oldExr = readAll(exr), oldPng = readAll(png);
+
+  const std::string log = dir + "/log.txt";
+  pid_t pid = ::fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, STDERR_FILENO);
+    ::execl(TDPM_BINARY, TDPM_BINARY, "render", (dir + "/e.json").c_str(), "-q", "-t", "1", "--resolution", "1200x900",
+            "--seed", "2", "--exposure", "1", "-o", exr.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  bool sawTemporary = false;
+  for (int i = 0; i < 20000 && !sawTemporary; ++i) {  // at most ~20 s
+    for (const std::string& name : temporariesIn(dir)) {
+      struct stat st;
+      if (::stat((dir + "/" + name).c_str(), &st) == 0 && st.st_size > 0) sawTemporary = true;
+    }
+    if (!sawTemporary) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ::kill(pid, SIGINT);
+  int status = 0;
+  REQUIRE(::waitpid(pid, &status, 0) == pid);
+  CHECK(sawTemporary);
+  CHECK(temporariesIn(dir).empty());
+  if (WIFSIGNALED(status)) {
+    MESSAGE("interrupted while writing");
+    CHECK(WTERMSIG(status) == SIGINT);
+    CHECK(readAll(exr) == oldExr);
+    CHECK(readAll(png) == oldPng);
+  } else {
+    MESSAGE("the write finished before the signal");
+    CHECK(WEXITSTATUS(status) == 0);
+    CHECK(image::readExr(exr).metadata.at("tdpm/seed") == "2");
+    CHECK(readAll(png) != oldPng);
+  }
 }
 
 // ---- item 10: memory pre-flight ----
