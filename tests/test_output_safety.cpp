@@ -368,32 +368,35 @@ TEST_CASE("output safety: render writes through a symlinked output pair") {
 // In a child: a registered temporary, then SIGTERM: the temporary is gone
 // and the child died by SIGTERM.
 TEST_CASE("output safety: a signal removes registered temporaries and ends the process by that signal") {
-  const std::string dir = test::makeTempDir();
-  int pipeFd[2];
-  REQUIRE(::pipe(pipeFd) == 0);
-  pid_t pid = ::fork();
-  REQUIRE(pid >= 0);
-  if (pid == 0) {
-    quietChild();
+  for (int signo : {SIGTERM, SIGHUP, SIGINT}) {
+    CAPTURE(signo);
+    const std::string dir = test::makeTempDir();
+    int pipeFd[2];
+    REQUIRE(::pipe(pipeFd) == 0);
+    pid_t pid = ::fork();
+    REQUIRE(pid >= 0);
+    if (pid == 0) {
+      quietChild();
+      ::close(pipeFd[0]);
+      signals::install(signals::Mode::Exit);
+      AtomicFile f(dir + "/x.exr");
+      test::writeFile(f.tempPath(), "partial");
+      char ok = 1;
+      if (::write(pipeFd[1], &ok, 1) != 1) ::_exit(10);
+      ::raise(signo);
+      ::_exit(11);  // not reached
+    }
+    ::close(pipeFd[1]);
+    char ok = 0;
+    CHECK(::read(pipeFd[0], &ok, 1) == 1);
     ::close(pipeFd[0]);
-    signals::install(signals::Mode::Exit);
-    AtomicFile f(dir + "/x.exr");
-    test::writeFile(f.tempPath(), "partial");
-    char ok = 1;
-    if (::write(pipeFd[1], &ok, 1) != 1) ::_exit(10);
-    ::raise(SIGTERM);
-    ::_exit(11);  // not reached
+    int status = 0;
+    REQUIRE(::waitpid(pid, &status, 0) == pid);
+    CHECK(WIFSIGNALED(status));
+    CHECK(WTERMSIG(status) == signo);
+    CHECK(temporariesIn(dir).empty());
+    CHECK_FALSE(test::fileExists(dir + "/x.exr"));
   }
-  ::close(pipeFd[1]);
-  char ok = 0;
-  CHECK(::read(pipeFd[0], &ok, 1) == 1);
-  ::close(pipeFd[0]);
-  int status = 0;
-  REQUIRE(::waitpid(pid, &status, 0) == pid);
-  CHECK(WIFSIGNALED(status));
-  CHECK(WTERMSIG(status) == SIGTERM);
-  CHECK(temporariesIn(dir).empty());
-  CHECK_FALSE(test::fileExists(dir + "/x.exr"));
 }
 
 TEST_CASE("output safety: in stop mode the first signal only asks to stop, the second ends the process") {

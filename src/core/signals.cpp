@@ -42,8 +42,9 @@ void unlinkTemporaries() {
 [[noreturn]] void terminate(int signo) {
   unlinkTemporaries();
   // Starts with a newline: a progress bar may hold the current line.
-  writeStderr(signo == SIGINT ? "\ntdpm: interrupted by SIGINT (temporary files removed)\n"
-                              : "\ntdpm: terminated by SIGTERM (temporary files removed)\n");
+  writeStderr(signo == SIGINT    ? "\ntdpm: interrupted by SIGINT (temporary files removed)\n"
+              : signo == SIGHUP ? "\ntdpm: hung up (SIGHUP; temporary files removed)\n"
+                                : "\ntdpm: terminated by SIGTERM (temporary files removed)\n");
   struct sigaction sa;
   std::memset(&sa, 0, sizeof sa);
   sa.sa_handler = SIG_DFL;
@@ -77,7 +78,7 @@ void install(Mode mode) {
   gMode.store(int(mode));
   bool expected = false;
   if (!gInstalled.compare_exchange_strong(expected, true)) return;
-  for (int signo : {SIGINT, SIGTERM}) {
+  for (int signo : {SIGINT, SIGTERM, SIGHUP}) {
     struct sigaction old;
     if (::sigaction(signo, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
     struct sigaction sa;
@@ -86,6 +87,7 @@ void install(Mode mode) {
     sigemptyset(&sa.sa_mask);
     sigaddset(&sa.sa_mask, SIGINT);  // one handler at a time
     sigaddset(&sa.sa_mask, SIGTERM);
+    sigaddset(&sa.sa_mask, SIGHUP);
     sa.sa_flags = SA_RESTART;
     ::sigaction(signo, &sa, nullptr);
   }

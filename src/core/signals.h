@@ -1,4 +1,4 @@
-// core/signals.h — what SIGINT and SIGTERM do to a tdpm run.
+// core/signals.h — what SIGINT, SIGTERM and SIGHUP do to a tdpm run.
 // Owns: the signal handlers, the registry of temporary files a signal must
 // remove, the "stop requested" flag, and deferral around short critical
 // sections (renaming a finished output pair into place).
@@ -11,7 +11,7 @@
 namespace tdpm::signals {
 
 enum class Mode {
-  // The first SIGINT/SIGTERM removes the registered temporaries, prints
+  // The first SIGINT/SIGTERM/SIGHUP removes the registered temporaries, prints
   // "tdpm: interrupted by SIGINT (temporary files removed)" and ends the process
   // by the same signal (the shell reports 128+signo: 130 for Ctrl-C).
   Exit,
@@ -20,7 +20,8 @@ enum class Mode {
   Stop,
 };
 
-// Installs the handlers for SIGINT and SIGTERM (idempotent). A signal the
+// Installs the handlers for SIGINT, SIGTERM and SIGHUP (a closed
+// terminal) (idempotent). A signal the
 // parent set to SIG_IGN (e.g. `nohup`, background jobs) stays ignored.
 void install(Mode mode = Mode::Exit);
 void setMode(Mode mode);
