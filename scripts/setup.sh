@@ -43,7 +43,13 @@ fi
 
 jobs=$(nproc 2>/dev/null || echo 2)
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build -j "$jobs"
+# render needs only the executable (not the tests and benchmarks); test and
+# build make everything.
+if [ "$mode" = render ]; then
+  cmake --build build -j "$jobs" --target tdpm
+else
+  cmake --build build -j "$jobs"
+fi
 
 case "$mode" in
   render)

@@ -11,7 +11,9 @@
 #include <sstream>
 
 #include "cli/progress_bar.h"
+#include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/memory.h"
 #include "core/timer.h"
 #include "image/exr.h"
 #include "image/png.h"
@@ -87,13 +89,37 @@ void parseResolution(const std::string& text, int& w, int& h) {
   h = b;
 }
 
-// Everything that can be wrong with the flags or the output location is
-// found here, before the scene is loaded or anything is rendered.
-void validateOutput(const std::string& out) {
+void refuseOverwritingInput(const std::string& out, const std::string& preview, const std::string& input,
+                            const std::string& what);
+
+// Everything that can be wrong with the output location is found here,
+// before the scene is loaded or anything is rendered: the name, the
+// directory, a directory or other non-file in the way, a name too long for
+// the file system (also the temporary's), a dangling symbolic link, for the
+// EXR and its PNG preview alike (core/atomic_file checkOutputPath).
+void validateOutput(const std::string& out, const std::string& preview, const std::string& scenePath) {
   if (!endsWith(out, ".exr")) throw Error("--output: '" + out + "' must end in .exr (the PNG preview goes beside it)");
   std::string dir = directoryOf(out);
   if (access(dir.c_str(), W_OK) != 0)
     throw Error("--output: cannot write to directory '" + dir + "' (" + std::strerror(errno) + ")");
+  try {
+    checkOutputPath(out);
+    checkOutputPath(preview);
+  } catch (const Error& e) {
+    throw Error(std::string("--output: ") + e.what());
+  }
+  if (sameFile(out, preview))
+    throw Error("--output: '" + out + "' and its PNG preview '" + preview + "' are the same file");
+  refuseOverwritingInput(out, preview, scenePath, "the scene file");
+}
+
+// An output that is an input (the same file, also through a link) would
+// destroy it: refused, as compare refuses it for --csv.
+void refuseOverwritingInput(const std::string& out, const std::string& preview, const std::string& input,
+                            const std::string& what) {
+  for (const std::string* o : {&out, &preview})
+    if (sameFile(*o, input))
+      throw Error("--output: '" + *o + "' is " + what + " '" + input + "'; writing it would destroy an input");
 }
 
 std::string formatMiB(uint64_t bytes) {
@@ -181,12 +207,50 @@ RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc,
   return o;
 }
 
+// accumulation renders each of its N frames with spp/N samples per pixel
+// (at least 1) and its own photon maps of 1/N of the counts: with more
+// frames than samples, or counts that are not multiples of N, the totals
+// differ from what was asked. Said before the render.
+std::vector<std::string> accumulationSppWarnings(const RenderOptions& o, bool hasMotion) {
+  std::vector<std::string> w;
+  if (o.method != "accumulation" || !hasMotion || o.frames <= 1) return w;
+  int batch = std::max(1, o.spp / o.frames);
+  int maxBatch = std::max(batch, std::max(o.spp, o.maxSpp) / o.frames);
+  if (batch * o.frames != o.spp || (o.maxSpp > o.spp && maxBatch * o.frames != o.maxSpp))
+    w.push_back("accumulation: " + std::to_string(o.frames) + " frames of " + std::to_string(batch) +
+                (maxBatch > batch ? "-" + std::to_string(maxBatch) : std::string()) +
+                " samples per pixel each take " + std::to_string(batch * o.frames) +
+                (maxBatch > batch ? "-" + std::to_string(maxBatch * o.frames) : std::string()) +
+                " samples per pixel in all, not the " + std::to_string(o.spp) +
+                " asked for (make --spp a multiple of --frames)");
+  return w;
+}
+
+// After the render: every frame's photon pass emits at least one batch of
+// paths, so many frames with few photons each store more than asked.
+void warnAccumulationPhotons(const RenderOptions& o, bool hasMotion, const RenderStats& st) {
+  if (o.method != "accumulation") return;
+  const int frames = hasMotion ? std::max(1, o.frames) : 1;
+  auto check = [&](const char* kind, size_t asked, size_t stored) {
+    if (asked > 0 && double(stored) > 1.1 * double(asked))
+      std::fprintf(stderr,
+                   "tdpm: warning: accumulation: %s %s photons stored, not the %s asked for: each of the %d frames "
+                   "traces at least one batch of photon paths (fewer --frames or more photons avoid it)\n",
+                   formatCount(stored).c_str(), kind, formatCount(asked).c_str(), frames);
+  };
+  check("caustic", o.causticPhotons, st.causticStored);
+  check("global", o.globalPhotons, st.globalStored);
+}
+
 }  // namespace
 
 CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   CLI::App* c = app.add_subcommand("render", "Render a scene file to an OpenEXR image and a PNG preview");
   c->add_option("scene", a.scene, "Scene file (JSON, see docs/scene-format.md)")->required();
-  c->add_option("-o,--output", a.output, "Output EXR path (default: <scene name>.exr here); the PNG preview goes beside it");
+  c->add_option("-o,--output", a.output, "Output EXR path (default: <scene name>.exr here); the PNG preview goes beside it. Both are written to "
+                "temporaries and renamed into place together: on any failure or signal the old pair stays. A "
+                "symbolic link is written through (its target is replaced, keeping its mode); a path that is an input "
+                "(scene, mesh) is refused. Checked before rendering");
   c->add_option("-m,--method", a.method, "Rendering method: " + methodList() + " (default: the scene's, else time)");
   c->add_option("--spp", a.spp, "Samples per pixel in the first pass, and per extra adaptive batch (default 16)")
       ->check(rangeOf(limits::kSpp));
@@ -211,7 +275,9 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
       ->check(rangeOf(limits::kPhotons))->group(photonGroup);
   c->add_option("--global-photons", a.globalPhotons, "Global photons to store (default 50000)")
       ->check(rangeOf(limits::kPhotons))->group(photonGroup);
-  c->add_option("--frames", a.frames, "accumulation: in-between frames, each with 1/N of the photons and of the samples (default 8)")
+  c->add_option("--frames", a.frames, "accumulation: in-between frames, each with 1/N of the photons and of the samples (default 8); every "
+                "frame takes at least 1 sample per pixel and one batch of photon paths, so frames above --spp or "
+                "far above the photon counts raise the totals (a warning says so)")
       ->check(rangeOf(limits::kFrames))->group(photonGroup);
   c->add_option("--search", a.search, "time: twopass (space, then time) or 4d (space-time kd-tree) (default twopass)")
       ->check(CLI::IsMember({"twopass", "4d"}))->group(photonGroup);
@@ -243,7 +309,8 @@ int runRender(const RenderArgs& a) {
     throw Error("--method: unknown method '" + *a.method + "' (expected " + methodList() + ")");
   int width = 0, height = 0;
   if (a.resolution) parseResolution(*a.resolution, width, height);
-  validateOutput(output);
+  const std::string preview = image::previewPathFor(output);
+  validateOutput(output, preview, a.scene);
 
   scene::SceneDescription desc = scene::loadScene(a.scene);
   if (a.kappa) {
@@ -257,22 +324,32 @@ int runRender(const RenderArgs& a) {
                   "] (float range)");
     }
   }
+  for (const scene::ObjectDesc& o : desc.objects)
+    if (o.shape.type == scene::ShapeDesc::Type::Mesh)
+      refuseOverwritingInput(output, preview, o.shape.meshFile, "the mesh file of object '" + o.name + "'");
   RenderOptions opt = mergeOptions(a, desc.render, a.scene);
   float exposure = pick(a.exposure, desc.render.exposure, 0.0f);
   if (a.resolution) {
     desc.camera.width = width;
     desc.camera.height = height;
+    opt.resolutionSource = "--resolution " + *a.resolution;
+  } else {
+    opt.resolutionSource = "camera.resolution in " + a.scene;
   }
 
   ThreadLimit limit(a.threads);
   ProgressBar bar(ProgressBar::shouldShow(a.quiet));
   auto scene = Scene::build(desc);
+  for (const std::string& w : accumulationSppWarnings(opt, scene->hasMotion))
+    std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
   RenderStats stats;
   Film film = render(*scene, opt, bar.progress(), stats);
   bar.finish();
   for (const std::string& w : stats.warnings) std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
+  warnAccumulationPhotons(opt, scene->hasMotion, stats);
 
-  image::ExrFile exr = filmToExr(film);
+  const int filmWidth = film.width, filmHeight = film.height;
+  image::ExrFile exr = filmToExr(std::move(film));  // moved: the write path holds no second film
   char seconds[32];
   std::snprintf(seconds, sizeof seconds, "%.3f", stats.seconds);
   exr.metadata = {{"tdpm/version", TDPM_VERSION},
@@ -291,18 +368,12 @@ int runRender(const RenderArgs& a) {
     if (opt.method == "time") exr.metadata["tdpm/search"] = opt.spaceTime4D ? "4d" : "twopass";
     if (opt.method == "accumulation") exr.metadata["tdpm/frames"] = std::to_string(opt.frames);
   }
-  const std::string preview = image::previewPathFor(output);
-  image::writeExr(output, exr);
-  try {
-    image::writePngPreview(preview, exr.color, exposure);
-  } catch (...) {
-    std::remove(output.c_str());  // both outputs or neither
-    throw;
-  }
+  writeRenderOutputs(output, preview, exr, exposure);  // both files or neither
+  stats.peakResidentBytes = peakResidentBytes();      // --stats: the write path included
 
   if (!a.quiet) {
     std::fprintf(stderr, "tdpm: %s, %s: %dx%d, %s camera samples (%d-%d per pixel), %.2f s in all -> %s (preview %s)\n",
-                 a.scene.c_str(), opt.method.c_str(), film.width, film.height,
+                 a.scene.c_str(), opt.method.c_str(), filmWidth, filmHeight,
                  formatCount(stats.cameraSamples).c_str(), stats.minSpp, stats.maxSpp, total.seconds(), output.c_str(),
                  preview.c_str());
     if (photonMethod)

@@ -1,16 +1,22 @@
-// core/atomic_file.cpp — temp file creation, rename-on-commit, cleanup.
+// core/atomic_file.cpp — target resolution, temp file creation,
+// rename-on-commit (single and grouped, with rollback), cleanup.
 #include "core/atomic_file.h"
 
 #include <fcntl.h>
+#include <limits.h>
+#include <stdio.h>  // renameat2, RENAME_EXCHANGE (glibc >= 2.28)
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <vector>
 
 #include "core/error.h"
+#include "core/signals.h"
 
 namespace tdpm {
 namespace {
@@ -33,6 +39,55 @@ void splitPath(const std::string& path, std::string& dir, std::string& name) {
   }
 }
 
+// The longest file name the directory's file system accepts.
+size_t nameMax(const std::string& dir) {
+  long n = ::pathconf(dir.empty() ? "." : dir.c_str(), _PC_NAME_MAX);
+  return n > 0 ? size_t(n) : size_t(NAME_MAX);
+}
+
+// ".<name>.tmp.<pid>.<n>" in `dir`, with <name> cut (at a UTF-8 character
+// boundary) so the whole name fits in `limit` bytes.
+std::string tempName(const std::string& dir, const std::string& name, size_t limit, unsigned n) {
+  const std::string suffix = ".tmp." + std::to_string(::getpid()) + "." + std::to_string(n);
+  size_t keep = name.size();
+  if (1 + keep + suffix.size() > limit) {
+    keep = limit > 1 + suffix.size() ? limit - 1 - suffix.size() : 0;
+    while (keep > 0 && (static_cast<unsigned char>(name[keep]) & 0xC0) == 0x80) --keep;
+  }
+  return dir + "." + name.substr(0, keep) + suffix;
+}
+
+// Follows `target` if it is a symbolic link; fills `st` and returns true if
+// the final file exists. Throws for what cannot be replaced.
+bool resolveTarget(const std::string& target, std::string& final, struct stat& st) {
+  final = target;
+  if (::lstat(target.c_str(), &st) != 0) {
+    int err = errno;
+    if (err == ENOENT) return false;  // a missing directory is reported when the temp is created
+    throw Error(target + ": " + osReason(err));
+  }
+  if (S_ISLNK(st.st_mode)) {
+    char* real = ::realpath(target.c_str(), nullptr);
+    if (!real) {
+      int err = errno;
+      char link[PATH_MAX];
+      ssize_t n = ::readlink(target.c_str(), link, sizeof link - 1);
+      std::string to = n > 0 ? std::string(link, size_t(n)) : std::string("?");
+      throw Error(target + ": is a symbolic link to '" + to + "', which cannot be written through (" +
+                  osReason(err) + ")");
+    }
+    final = real;
+    std::free(real);
+    if (::stat(final.c_str(), &st) != 0) {
+      int err = errno;
+      throw Error(target + ": " + osReason(err));
+    }
+  }
+  if (S_ISDIR(st.st_mode)) throw Error(target + ": is a directory");
+  if (!S_ISREG(st.st_mode)) throw Error(target + ": exists and is not a regular file");
+  return true;
+}
+
 }  // namespace
 
 AtomicFile::AtomicFile(std::string target) : target_(std::move(target)) {
@@ -41,21 +96,30 @@ AtomicFile::AtomicFile(std::string target) : target_(std::move(target)) {
   if (name.empty() || name == "." || name == "..")
     throw Error(target_ + ": not a file name");
 
-  // The target itself must not be a directory: rename would fail only at the
-  // very end, after all the work.
+  auto checkLength = [&] {
+    const size_t limit = nameMax(dir);
+    if (name.size() > limit)
+      throw Error(target_ + ": the file name is " + std::to_string(name.size()) +
+                  " bytes long, more than the file system allows (" + std::to_string(limit) + ")");
+    return limit;
+  };
+  checkLength();
+  // The target must be something rename can replace: rename would fail
+  // only at the very end, after all the work.
   struct stat st;
-  if (::stat(target_.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
-    throw Error(target_ + ": is a directory");
+  resolveTarget(target_, final_, st);
+  splitPath(final_, dir, name);
+  const size_t limit = checkLength();
 
   // O_EXCL makes the name ours even if a stale temp of a crashed run with the
   // same pid exists; then we just take the next counter value. Mode 0666
   // (minus umask) so the final file has normal permissions, unlike mkstemp's
-  // 0600.
-  const std::string prefix = dir + "." + name + ".tmp." + std::to_string(::getpid()) + ".";
+  // 0600; a replaced file's mode is kept.
   for (int attempt = 0; attempt < 100; ++attempt) {
-    std::string candidate = prefix + std::to_string(gTempCounter.fetch_add(1));
+    std::string candidate = tempName(dir, name, limit, gTempCounter.fetch_add(1));
     int fd = ::open(candidate.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd >= 0) {
+      signals::addTemporary(candidate.c_str());
       ::close(fd);
       temp_ = std::move(candidate);
       return;
@@ -70,25 +134,116 @@ AtomicFile::AtomicFile(std::string target) : target_(std::move(target)) {
 }
 
 AtomicFile::~AtomicFile() {
-  if (!committed_ && !temp_.empty()) ::unlink(temp_.c_str());
+  if (!committed_ && !temp_.empty()) {
+    ::unlink(temp_.c_str());
+    signals::removeTemporary(temp_.c_str());
+  }
 }
 
-void AtomicFile::commit() {
-  TDPM_ASSERT(!committed_, "AtomicFile::commit called twice");
-  // fsync before rename: otherwise a crash right after could leave the new
-  // name pointing at an empty file on some file systems.
+// fsync before rename: otherwise a crash right after could leave the new
+// name pointing at an empty file on some file systems.
+void AtomicFile::sync() const {
   int fd = ::open(temp_.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     int err = errno;
     throw Error(target_ + ": temporary file " + temp_ + " vanished: " + osReason(err));
   }
-  ::fsync(fd);
-  ::close(fd);
-  if (::rename(temp_.c_str(), target_.c_str()) != 0) {
-    int err = errno;
-    throw Error(target_ + ": cannot rename the finished file into place: " + osReason(err));
+  int rc = ::fsync(fd);
+  int err = errno;
+  // The replaced file's mode (and owner, if we may) carry over. Set only
+  // now: a read-only mode on the temporary would stop its writer.
+  struct stat old;
+  if (::stat(final_.c_str(), &old) == 0 && S_ISREG(old.st_mode)) {
+    if (::geteuid() == 0 && (old.st_uid != 0 || old.st_gid != 0) && ::fchown(fd, old.st_uid, old.st_gid) != 0) {
+      // Best effort: the content matters more than the owner.
+    }
+    if (::fchmod(fd, old.st_mode & 07777) != 0) {
+      // Best effort, as for the owner.
+    }
   }
-  committed_ = true;
+  ::close(fd);
+  if (rc != 0 && err != EINVAL && err != EROFS)  // EINVAL/EROFS: no fsync on this file system
+    throw Error(target_ + ": cannot flush the finished file to disk: " + osReason(err));
+}
+
+void AtomicFile::commit() { commitTogether({this}); }
+
+void commitTogether(std::initializer_list<AtomicFile*> list) {
+  const std::vector<AtomicFile*> files(list);
+  for (const AtomicFile* f : files) TDPM_ASSERT(!f->committed_, "AtomicFile committed twice");
+  for (const AtomicFile* f : files) f->sync();  // may throw: nothing renamed yet
+
+  // How to undo one rename: the target did not exist (remove it), the old
+  // file was swapped into the temporary's name (swap back), or the old file
+  // has a second hard link (rename it back).
+  enum class Undo { Remove, Swap, Relink };
+  struct Done {
+    Undo undo;
+    std::string backup;
+  };
+  std::vector<Done> done;
+  signals::Deferral noSignalsUntilDone;
+
+  auto rollback = [&] {
+    for (size_t j = done.size(); j-- > 0;) {
+      const AtomicFile& f = *files[j];
+      if (done[j].undo == Undo::Swap)
+        ::renameat2(AT_FDCWD, f.temp_.c_str(), AT_FDCWD, f.final_.c_str(), RENAME_EXCHANGE);
+      else if (done[j].undo == Undo::Relink)
+        ::rename(done[j].backup.c_str(), f.final_.c_str());
+      else
+        ::unlink(f.final_.c_str());
+    }
+  };
+
+  for (size_t i = 0; i < files.size(); ++i) {
+    const AtomicFile& f = *files[i];
+    const bool last = i + 1 == files.size();  // nothing after it can fail: no undo needed
+    struct stat st;
+    const bool exists = ::lstat(f.final_.c_str(), &st) == 0;
+    Done step{Undo::Remove, {}};
+    int rc = -1;
+    if (exists && !last) {
+      rc = ::renameat2(AT_FDCWD, f.temp_.c_str(), AT_FDCWD, f.final_.c_str(), RENAME_EXCHANGE);
+      if (rc == 0) {
+        step.undo = Undo::Swap;
+      } else if (errno == EINVAL || errno == ENOSYS || errno == ENOTSUP) {
+        // A file system without RENAME_EXCHANGE: keep the old file under a
+        // second name until the group is done.
+        std::string dir, name;
+        splitPath(f.final_, dir, name);
+        step.backup = tempName(dir, name, nameMax(dir), gTempCounter.fetch_add(1));
+        if (::link(f.final_.c_str(), step.backup.c_str()) == 0) step.undo = Undo::Relink;
+        else step.backup.clear();  // no way back for this one; the renames rarely fail here
+        rc = ::rename(f.temp_.c_str(), f.final_.c_str());
+      }
+    } else {
+      rc = ::rename(f.temp_.c_str(), f.final_.c_str());
+    }
+    if (rc != 0) {
+      int err = errno;
+      if (!step.backup.empty()) ::unlink(step.backup.c_str());
+      rollback();
+      throw Error(f.target_ + ": cannot rename the finished file into place: " + osReason(err) +
+                  (i > 0 ? " (the other outputs were left as they were)" : ""));
+    }
+    done.push_back(step);
+  }
+  for (size_t i = 0; i < files.size(); ++i) {
+    AtomicFile& f = *files[i];
+    if (done[i].undo == Undo::Swap) ::unlink(f.temp_.c_str());  // now the old file
+    if (done[i].undo == Undo::Relink) ::unlink(done[i].backup.c_str());
+    signals::removeTemporary(f.temp_.c_str());
+    f.committed_ = true;
+  }
+}
+
+void checkOutputPath(const std::string& target) { AtomicFile probe(target); }
+
+bool sameFile(const std::string& a, const std::string& b) {
+  struct stat sa, sb;
+  return ::stat(a.c_str(), &sa) == 0 && ::stat(b.c_str(), &sb) == 0 && sa.st_dev == sb.st_dev &&
+         sa.st_ino == sb.st_ino;
 }
 
 void writeTextFileAtomic(const std::string& path, const std::string& contents) {

@@ -71,6 +71,13 @@ const Channel* ExrFile::findChannel(const std::string& name) const {
 // ---- writing ----
 
 void writeExr(const std::string& path, const ExrFile& file) {
+  // Created first: a missing or read-only directory fails here, in our words.
+  AtomicFile out(path);
+  writeExrTo(out.tempPath(), path, file);
+  out.commit();
+}
+
+void writeExrTo(const std::string& tempPath, const std::string& path, const ExrFile& file) {
   const ImageRgb& img = file.color;
   TDPM_ASSERT(!img.empty(), "writeExr: empty image");
   TDPM_ASSERT(img.pixels.size() == img.pixelCount(), "writeExr: pixel count does not match size");
@@ -81,8 +88,6 @@ void writeExr(const std::string& path, const ExrFile& file) {
     TDPM_ASSERT(c.values.size() == img.pixelCount(), "writeExr: channel " + c.name + " has the wrong length");
   }
 
-  // Created first: a missing or read-only directory fails here, in our words.
-  AtomicFile out(path);
   try {
     Imf::Header header(img.width, img.height);
     header.compression() = Imf::ZIP_COMPRESSION;  // lossless, ~2x on renders
@@ -106,7 +111,7 @@ void writeExr(const std::string& path, const ExrFile& file) {
     {
       // Scope: the OutputFile destructor writes the line offset table, so it
       // must be closed before the rename.
-      Imf::OutputFile exr(out.tempPath().c_str(), header);
+      Imf::OutputFile exr(tempPath.c_str(), header);
       exr.setFrameBuffer(fb);
       exr.writePixels(img.height);
     }
@@ -115,7 +120,6 @@ void writeExr(const std::string& path, const ExrFile& file) {
   } catch (const std::exception& e) {
     throw Error(path + ": cannot write OpenEXR file: " + e.what());
   }
-  out.commit();
 }
 
 // ---- reading ----

@@ -36,6 +36,10 @@ struct ExrFile {
 // Inconsistent input (empty image, channel of the wrong length, duplicate
 // or reserved channel names) is a bug: TDPM_ASSERT.
 void writeExr(const std::string& path, const ExrFile& file);
+// The same, into the file `tempPath` as it is (not atomic; errors name
+// `path`): for callers that commit several outputs together
+// (core/atomic_file commitTogether).
+void writeExrTo(const std::string& tempPath, const std::string& path, const ExrFile& file);
 
 // Reads the data window of a flat (scanline or tiled) EXR, first part:
 //  * colour from R, G, B (any pixel type, converted to float); an image with

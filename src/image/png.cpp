@@ -36,22 +36,27 @@ ImageRgb8 toPreview(const ImageRgb& image, float exposureStops) {
 }
 
 void writePngPreview(const std::string& path, const ImageRgb& image, float exposureStops) {
+  AtomicFile out(path);
+  writePngPreviewTo(out.tempPath(), path, image, exposureStops);
+  out.commit();
+}
+
+void writePngPreviewTo(const std::string& tempPath, const std::string& path, const ImageRgb& image,
+                       float exposureStops) {
   TDPM_ASSERT(!image.empty(), "writePngPreview: empty image");
   TDPM_ASSERT(image.pixels.size() == image.pixelCount(), "writePngPreview: pixel count does not match size");
   ImageRgb8 pixels = toPreview(image, exposureStops);
 
-  AtomicFile out(path);
   png_image png{};
   png.version = PNG_IMAGE_VERSION;
   png.width = png_uint_32(image.width);
   png.height = png_uint_32(image.height);
   png.format = PNG_FORMAT_RGB;  // 8-bit, non-linear: libpng adds an sRGB chunk
-  if (!png_image_write_to_file(&png, out.tempPath().c_str(), 0, pixels.rgb.data(), 0, nullptr)) {
+  if (!png_image_write_to_file(&png, tempPath.c_str(), 0, pixels.rgb.data(), 0, nullptr)) {
     std::string why = png.message;
     png_image_free(&png);
     throw Error(path + ": cannot write PNG: " + why);
   }
-  out.commit();
 }
 
 ImageRgb8 readPng(const std::string& path) {

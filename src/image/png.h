@@ -28,6 +28,10 @@ ImageRgb8 toPreview(const ImageRgb& image, float exposureStops);
 // Writes toPreview(image, exposureStops) as an 8-bit RGB PNG with an sRGB
 // chunk, atomically. Throws tdpm::Error "<path>: <reason>".
 void writePngPreview(const std::string& path, const ImageRgb& image, float exposureStops);
+// The same, into the file `tempPath` as it is (not atomic; errors name
+// `path`): for callers that commit several outputs together.
+void writePngPreviewTo(const std::string& tempPath, const std::string& path, const ImageRgb& image,
+                       float exposureStops);
 
 // Reads any PNG as 8-bit RGB (tests, and a preview check). Throws
 // tdpm::Error "<path>: <reason>".

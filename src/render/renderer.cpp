@@ -9,6 +9,8 @@
 #include <memory>
 #include <vector>
 
+#include <tbb/task_arena.h>
+
 #include "core/error.h"
 #include "core/memory.h"
 #include "core/rng.h"
@@ -16,6 +18,7 @@
 #include "photon/tracer.h"
 #include "render/path_tracer.h"
 #include "render/photon_integrator.h"
+#include "render/memory_budget.h"
 #include "render/photon_map.h"
 #include "render/tile_loop.h"
 #include "sampling/stratified.h"
@@ -176,26 +179,6 @@ PhotonIntegratorSettings integratorSettings(const Scene& scene, const RenderOpti
   return s;
 }
 
-// The photon maps the options will really trace (a caustic map needs a
-// specular surface, any map needs a light; accumulation traces 1/N per
-// frame, one frame's maps at a time), checked against MemAvailable before
-// the first photon is traced.
-void checkPhotonBudget(const Scene& scene, const RenderOptions& opt) {
-  if (opt.method == "pathtrace" || scene.lights.empty()) return;
-  size_t caustic = photon::sceneHasSpecular(scene) ? opt.causticPhotons : 0;
-  size_t global = opt.visualizeGlobal || opt.gatherRays > 0 ? opt.globalPhotons : 0;
-  bool spaceTime = false;
-  if (opt.method == "accumulation") {
-    size_t frames = size_t(scene.hasMotion ? std::max(1, opt.frames) : 1);
-    caustic = (caustic + frames - 1) / frames;
-    global = (global + frames - 1) / frames;
-  } else {
-    spaceTime = opt.spaceTime4D && opt.method != "static" && scene.hasMotion;
-  }
-  checkPhotonMemory(caustic, global, spaceTime, opt.maxDepth, availableMemoryBytes(), opt.causticPhotonsSource,
-                    opt.globalPhotonsSource);
-}
-
 std::string formatBytes(uint64_t b) {
   char buf[64];
   if (b >= (uint64_t(1) << 30)) std::snprintf(buf, sizeof buf, "%.2f GiB", double(b) / double(uint64_t(1) << 30));
@@ -282,8 +265,9 @@ bool isRenderMethod(const std::string& name) {
 Film render(const Scene& scene, const RenderOptions& opt, const Progress& progress, RenderStats& st) {
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
   if (!isRenderMethod(opt.method)) throw Error("unknown method '" + opt.method + "'");
-  // Before any work: an impossible photon budget is an error, not an OOM kill.
-  checkPhotonBudget(scene, opt);
+  // Before any work: an image or photon budget that cannot fit is an error,
+  // not an OOM kill (render/memory_budget.h).
+  checkMemoryBudget(scene, opt, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
   Timer timer;
   st = RenderStats{};
   if (scene.lights.empty() && scene.background.isBlack())

@@ -45,6 +45,8 @@ struct RenderOptions {
   // the flag, or the scene key and file (cli/render_command.cpp sets these).
   std::string causticPhotonsSource = "--photons";
   std::string globalPhotonsSource = "--global-photons";
+  // How the image size was set, for the memory-budget error.
+  std::string resolutionSource = "the camera resolution";
 };
 
 struct RenderStats {
@@ -64,9 +66,9 @@ struct RenderStats {
 const char* const* renderMethods();
 bool isRenderMethod(const std::string& name);
 
-// Throws tdpm::Error, before any photon is traced, when the photon maps
+// Throws tdpm::Error, before any work, when the image and the photon maps
 // the options ask for cannot fit in the machine's available memory
-// (checkPhotonMemory below with MemAvailable).
+// (render/memory_budget.h checkMemoryBudget with MemAvailable).
 Film render(const Scene& scene, const RenderOptions& options, const Progress& progress, RenderStats& stats);
 
 // ---- photon memory budget ----

@@ -1,0 +1,46 @@
+// render/memory_budget.h — the one memory pre-flight of a render: the
+// image (films while rendering, the EXR and PNG buffers while writing), the
+// per-thread sample buffers and the photon maps (render/renderer.h
+// photonMemoryBytes), summed and checked against MemAvailable before any
+// work, so an impossible --resolution or photon count is a located error
+// and not an OOM kill half an hour in.
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "render/renderer.h"
+
+namespace tdpm {
+
+// Bytes per pixel, as render/ and the write path hold them (measured with
+// `tdpm render --stats`, see docs/output-safety.md):
+// a Film: colour (12) + samples taken (4) + variance of the mean (12).
+constexpr uint64_t kFilmBytesPerPixel = 2 * 12 + 4;
+// Writing: the film moved into the EXR (28) + the three split variance
+// layers while the interleaved variance still exists (12); the 8-bit
+// preview (3) comes after that variance is freed (render/film_output.h).
+constexpr uint64_t kWriteBytesPerPixel = kFilmBytesPerPixel + 12;
+// Per camera sample of a batch, per thread: the sample (12) + its strata (12).
+constexpr uint64_t kSampleBytes = 24;
+
+struct MemoryEstimate {
+  uint64_t pixels = 0;
+  uint64_t films = 0;    // the films alive while rendering (accumulation: 3)
+  uint64_t samples = 0;  // per-thread batch buffers
+  uint64_t photons = 0;  // photonMemoryBytes of the maps traced (one frame's for accumulation)
+  uint64_t write = 0;    // the EXR and PNG buffers while writing
+  // The most held at once: rendering (films + samples + photons) or writing.
+  uint64_t peak() const;
+};
+
+// What rendering `scene` with `opt` on `threads` threads holds at its peak.
+MemoryEstimate estimateRenderMemory(const Scene& scene, const RenderOptions& opt, int threads);
+
+// Throws tdpm::Error when estimateRenderMemory(...).peak() exceeds
+// `available` less memoryMarginBytes: naming opt.resolutionSource when the
+// image alone does not fit, else the photon counts' sources (as
+// checkPhotonMemory does), else both, with bytes needed and available.
+// available == 0 means unknown (no /proc): no check.
+void checkMemoryBudget(const Scene& scene, const RenderOptions& opt, int threads, uint64_t available);
+
+}  // namespace tdpm
