@@ -14,6 +14,7 @@
 #include "core/rng.h"
 #include "core/timer.h"
 #include "math/frame.h"
+#include "photon/surface_tag.h"
 #include "sampling/warp.h"
 #include "scene/bsdf.h"
 
@@ -284,7 +285,9 @@ struct Tracer {
       const Material& mat = scene.materials[scene.objects[hit.object].material];
       if (!mat.isDeltaOnly()) {
         bool store = settings.kind == MapKind::Global || (bounce > 0 && allSpecular);
-        if (store) out.add(hit.p, power * float(energyScale), -dir, time);
+        // The side it arrived on keeps it out of estimates on the other side
+        // of the same object (photon/surface_tag.h).
+        if (store) out.add(hit.p, power * float(energyScale), -dir, time, surfaceTag(hit.object, dot(hit.n, dir) > 0.0f));
         if (settings.kind == MapKind::Caustic) return rays;  // L S+ D ends here
       }
       ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "photon/surface_tag.h"
 #include "render/direct_light.h"
 #include "scene/bsdf.h"
 
@@ -32,6 +33,10 @@ Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::G
   if (!map || map->size() == 0) return Rgb(0.0f);
   auto brdf = [&ctx](Vec3f wi, Vec3f) { return bsdfEval(ctx, wi); };
   Vec3f n = ctx.frame.n;  // faces the viewer: photons from the other side do not count
+  // Nor do photons on the other side of this object's surface, which the
+  // side test alone lets through convex edges and thin parts of closed
+  // objects (photon/surface_tag.h).
+  uint8_t tag = photon::surfaceTag(hit.object, dot(hit.n, wo) < 0.0f);
   if (timeDependent) {
     ++counts.timeDependent;
     if (!g) {
@@ -40,7 +45,7 @@ Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::G
       g = std::make_unique<estimate::Gatherer>(map->tree, o);
     }
     float t = scene_.shutter.instant() ? map->store.t0() : scene_.shutter.fromNormalized(time01);
-    return g->radiance(hit.p, n, wo, t, brdf);
+    return g->radiance(hit.p, n, wo, t, brdf, nullptr, tag);
   }
   ++counts.standard;
   if (!g3) {
@@ -48,7 +53,7 @@ Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::G
     o.method = estimate::Method::Standard;
     g3 = std::make_unique<estimate::Gatherer>(map->spatialTree(), o);
   }
-  return g3->standard(hit.p, n, wo, brdf);
+  return g3->standard(hit.p, n, wo, brdf, nullptr, tag);
 }
 
 Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, float time01, bool touched, Rng& rng,
