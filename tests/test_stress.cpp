@@ -467,3 +467,25 @@ TEST_CASE("stress: motion much larger than the scene") {
   d.camera.motion = {{0.0f, {0, 2.0f, 3.0f}, {0, 0.3f, 0}, {0, 1, 0}}, {1.0f, {1e4f, 2.0f, 3.0f}, {1e4f, 0.3f, 0}, {0, 1, 0}}};
   checkExtremeScene("light and camera translating 1e4 units", d, eo);
 }
+
+TEST_CASE("stress: a zero-power light gets a warning, as a scene with no lights does") {
+  auto d = baseScene(8, 8);
+  d.lights.push_back(pointLight({1, 2, 0}, 0.0f));  // lights[1]: valid, but emits nothing
+  auto has = [](const RenderStats& st, const std::string& text) {
+    for (const std::string& w : st.warnings)
+      if (w.find(text) != std::string::npos) return true;
+    return false;
+  };
+  RenderOptions o;
+  o.method = "pathtrace";
+  o.spp = 1;
+  RenderStats st;
+  renderScene(d, o, &st);
+  CHECK(has(st, "lights[1] has zero power"));
+  CHECK_FALSE(has(st, "lights[0]"));
+  CHECK_FALSE(has(st, "every light"));
+  d.lights[0].power = Rgb(0.0f);
+  renderScene(d, o, &st);
+  CHECK(has(st, "lights[0] has zero power"));
+  CHECK(has(st, "every light has zero power and the background is black"));
+}

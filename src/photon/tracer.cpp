@@ -28,9 +28,13 @@ constexpr uint32_t kPilotBatches = 16;
 // enough work to keep every core busy, small next to a large map.
 constexpr uint64_t kBatchesPerChunk = 256;
 // A scene that stores (almost) nothing must not hang: the pilot gives up
-// after kMaxPilotPaths paths, and the emission is capped at
+// after kMaxPilotPaths paths or kMaxPilotRays rays in one round, whichever
+// comes first (a point light inside a closed mirror sphere bounces every
+// path to the depth limit and stores nothing: 58 s for a black 64x48 image
+// when the pilot was bounded by paths alone), and the emission is capped at
 // kMaxPathsPerPhoton paths per wanted photon (both reported as warnings).
-constexpr uint64_t kMaxPilotPaths = uint64_t(1) << 22;
+constexpr uint64_t kMaxPilotPaths = uint64_t(1) << 20;
+constexpr uint64_t kMaxPilotRays = uint64_t(1) << 21;
 constexpr double kMaxPathsPerPhoton = 1000.0;
 
 // Radical inverse in base 2 with a random XOR scramble: a (0,1)-sequence,
@@ -365,7 +369,8 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   const char* stage = settings.kind == MapKind::Caustic ? "caustic photons" : "global photons";
 
   // Pilot: how many photons does a path store on average? Grow the pilot
-  // until something is stored or the cap says the scene stores nothing.
+  // (8x a round) until something is stored or a round would exceed the
+  // path or ray budget; then the scene is taken to store nothing.
   uint64_t pilotBatches = kPilotBatches;
   size_t stored = 0;
   uint64_t pilotRays = 0;
@@ -374,14 +379,21 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
     PhotonStore pilot = tracer.traceBatches(pilotBatches, 1.0, Progress{}, stage, 0, &rays);
     pilotRays += rays;
     stored = pilot.size();
-    uint64_t paths = pilotBatches * kPathsPerBatch;
-    if (stored > 0 || paths >= kMaxPilotPaths) break;
-    pilotBatches *= 8;
+    if (stored > 0) break;
+    double raysPerBatch = std::max(1.0, double(rays) / double(pilotBatches));
+    uint64_t next = std::min({pilotBatches * 8, kMaxPilotPaths / kPathsPerBatch,
+                              uint64_t(double(kMaxPilotRays) / raysPerBatch)});
+    if (next <= pilotBatches) break;
+    pilotBatches = next;
   }
   if (stored == 0) {
+    // Zero of n: the rate is below 3 / n at 95% confidence.
+    uint64_t paths = pilotBatches * kPathsPerBatch;
     result.rays = pilotRays;
-    result.warning = std::string(stage) + ": none of " + std::to_string(pilotBatches * kPathsPerBatch) +
-                     " paths stored a photon; the map is empty";
+    result.seconds = timer.seconds();
+    result.warning = std::string(stage) + ": none of " + std::to_string(paths) + " paths (" +
+                     std::to_string(pilotRays) + " rays in all) stored a photon, so fewer than 1 in " +
+                     std::to_string(paths / 3) + " would (95% confidence); the map is empty";
     return result;
   }
   double perPath = double(stored) / double(pilotBatches * kPathsPerBatch);
