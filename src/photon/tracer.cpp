@@ -77,7 +77,7 @@ std::vector<Target> specularTargets(const Scene& scene) {
   std::vector<Target> t;
   for (const SceneObject& o : scene.objects)
     if (scene.materials[o.material].isDeltaOnly())
-      t.push_back({o.sweptBounds.center(), 0.5f * length(o.sweptBounds.diagonal()) * 1.001f + 1e-6f});
+      t.push_back({o.sweptBounds.center(), 0.5f * length(o.sweptBounds.diagonal()) * 1.001f});
   return t;
 }
 

@@ -124,7 +124,9 @@ void renderPixels(const Scene& scene, const Integrator& integrator, const Sampli
 
 float defaultMaxRadius(const Scene& scene, const RenderOptions& opt) {
   if (std::isfinite(opt.estimate.maxRadius)) return opt.estimate.maxRadius;
-  float diag = scene.bounds.empty() ? 1.0f : length(scene.bounds.diagonal());
+  // Of the scene's diagonal, clipped to a multiple of the view distance
+  // (Scene::extent): a huge floor must not make the search reach metres.
+  float diag = scene.bounds.empty() ? 1.0f : scene.extent();
   return opt.maxRadiusFraction * diag;
 }
 
