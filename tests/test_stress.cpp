@@ -35,7 +35,9 @@ namespace {
 // Floor, box, moving glass ball, a point light and an area light; every
 // length times `s`, every power times s^2 (so irradiance, and the image,
 // are the same at every scale).
-scene::SceneDescription scaledScene(float s) {
+// floorSize: the floor's side at scale 1 (a huge floor must not change
+// the picture of what the camera sees).
+scene::SceneDescription scaledScene(float s, float floorSize = 4.0f) {
   auto d = test::emptyScene(24, 18);
   d.camera.position = Vec3f{0, 2.0f, 3.5f} * s;
   d.camera.target = Vec3f{0, 0.3f, 0} * s;
@@ -43,7 +45,7 @@ scene::SceneDescription scaledScene(float s) {
   scene::MaterialDesc glass;
   glass.type = scene::MaterialDesc::Type::Dielectric;
   d.materials.push_back(glass);
-  d.objects.push_back(test::quad(Vec2f{4 * s, 4 * s}, {0, 0, 0}, 0));
+  d.objects.push_back(test::quad(Vec2f{floorSize * s, floorSize * s}, {0, 0, 0}, 0));
   d.objects.push_back(test::box(Vec3f{0.5f, 0.5f, 0.5f} * s, Vec3f{-0.8f, 0.25f, 0} * s, 0));
   auto ball = test::sphere(0.35f * s, Vec3f{0.3f, 0.7f, 0} * s, 1);
   ball.motion = test::translation(Vec3f{-0.3f, 0, 0} * s, Vec3f{0.3f, 0, 0} * s);
@@ -103,19 +105,36 @@ Agreement compareFilms(const Film& a, const Film& b) {
   return r;
 }
 
+void checkAgreement(const RenderOptions& o, const Film& ref, const Film& f, const std::string& what) {
+  Agreement r = compareFilms(ref, f);
+  MESSAGE(o.method << " " << what << ": mean " << r.meanB << " vs " << r.meanA << " (ratio " << r.meanB / r.meanA
+                   << ", sigma of the difference " << r.meanSigma << "); " << r.outliers << " of " << r.pixels
+                   << " pixels beyond 5 sigma, worst " << r.worstSigmas << " sigma");
+  CHECK(std::fabs(r.meanA - r.meanB) <= 4 * r.meanSigma + 1e-3 * r.meanA);
+  CHECK(r.outliers <= r.pixels / 100);  // 1% of the pixels may be 5-sigma outliers (caustic noise)
+}
+
 void checkScaleInvariance(const RenderOptions& o) {
   Film ref = renderScene(scaledScene(1.0f), o);
   double mean = 0;
   for (Rgb c : ref.color) mean += c.average();
   REQUIRE(mean > 0);  // a lit image
-  for (float s : {1e-3f, 1e3f}) {
+  // 1e-6 (issue 11: the photon methods lost the caustic there) to 1e3.
+  for (float s : {1e-6f, 1e-3f, 1e3f}) {
     Film f = renderScene(scaledScene(s), o);
-    Agreement r = compareFilms(ref, f);
-    MESSAGE(o.method << " at scale " << s << ": mean " << r.meanB << " vs " << r.meanA << " at scale 1 (ratio "
-                     << r.meanB / r.meanA << ", sigma of the difference " << r.meanSigma << "); " << r.outliers
-                     << " of " << r.pixels << " pixels beyond 5 sigma, worst " << r.worstSigmas << " sigma");
-    CHECK(std::fabs(r.meanA - r.meanB) <= 4 * r.meanSigma + 1e-3 * r.meanA);
-    CHECK(r.outliers <= r.pixels / 100);  // 1% of the pixels may be 5-sigma outliers (caustic noise)
+    checkAgreement(o, ref, f, "at scale " + std::to_string(s) + " against scale 1");
+  }
+}
+
+// Issue 11: a floor of 1e8 around the same scene gave an image mean of 2e-6
+// instead of 0.05 (ray offsets of 20 m), and one of 1e7 lost the caustic.
+// The camera sees floor to the horizon either way; a 100 m floor is the
+// reference (the point light puts ~1e-6 of its power beyond it).
+void checkHugeFloor(const RenderOptions& o) {
+  Film ref = renderScene(scaledScene(1.0f, 100.0f), o);
+  for (float size : {1e7f, 1e8f}) {
+    Film f = renderScene(scaledScene(1.0f, size), o);
+    checkAgreement(o, ref, f, "with a floor of " + std::to_string(size) + " against one of 100");
   }
 }
 
@@ -282,6 +301,19 @@ TEST_CASE("stress: the same scene at 1e-3, 1 and 1e3 scale renders the same imag
   renderScene(scaledScene(1e-3f), o, &st);
   CHECK(st.timeEstimates > 0);  // the moving ball makes the time-dependent estimate run
   checkScaleInvariance(o);
+}
+
+TEST_CASE("stress: a floor of 1e7 and 1e8 around the scene renders what a floor of 100 does") {
+  RenderOptions o;
+  o.method = "pathtrace";
+  o.spp = 16;
+  o.seed = 3;
+  checkHugeFloor(o);
+  o.method = "time";
+  o.spp = 8;
+  o.causticPhotons = 40000;
+  o.globalPhotons = 20000;
+  checkHugeFloor(o);
 }
 
 TEST_CASE("stress: grazing camera rays along a plane") {
@@ -466,4 +498,26 @@ TEST_CASE("stress: motion much larger than the scene") {
   d.lights[0].motion = test::translation({0, 0, 0}, {1e4f, 0, 0});  // the light does
   d.camera.motion = {{0.0f, {0, 2.0f, 3.0f}, {0, 0.3f, 0}, {0, 1, 0}}, {1.0f, {1e4f, 2.0f, 3.0f}, {1e4f, 0.3f, 0}, {0, 1, 0}}};
   checkExtremeScene("light and camera translating 1e4 units", d, eo);
+}
+
+TEST_CASE("stress: a zero-power light gets a warning, as a scene with no lights does") {
+  auto d = baseScene(8, 8);
+  d.lights.push_back(pointLight({1, 2, 0}, 0.0f));  // lights[1]: valid, but emits nothing
+  auto has = [](const RenderStats& st, const std::string& text) {
+    for (const std::string& w : st.warnings)
+      if (w.find(text) != std::string::npos) return true;
+    return false;
+  };
+  RenderOptions o;
+  o.method = "pathtrace";
+  o.spp = 1;
+  RenderStats st;
+  renderScene(d, o, &st);
+  CHECK(has(st, "lights[1] has zero power"));
+  CHECK_FALSE(has(st, "lights[0]"));
+  CHECK_FALSE(has(st, "every light"));
+  d.lights[0].power = Rgb(0.0f);
+  renderScene(d, o, &st);
+  CHECK(has(st, "lights[0] has zero power"));
+  CHECK(has(st, "every light has zero power and the background is black"));
 }

@@ -17,6 +17,11 @@
 //    in Jensen: thin objects do not leak light through. The search radius is
 //    still that of the k nearest of either side (the estimate stays
 //    consistent; it is the number found inside the known disc).
+//  * Photons on the other side of the gather point's own object's surface
+//    never count (photon/surface_tag.h): the side test alone lets light
+//    through the convex edges and thin parts of closed objects. The query
+//    passes its surface tag (kNoSurfaceTag: no such rule); the radius is
+//    again that of the k nearest, whatever their tags.
 //  * Radius: with k found, r = distance of the k-th; with fewer, every
 //    photon within maxRadius was found and r = maxRadius (if maxRadius is
 //    infinite, the farthest found). r^2 is at least minRadius2, so
@@ -39,6 +44,7 @@
 #include "estimate/kernels.h"
 #include "math/vec.h"
 #include "photon/kdtree.h"
+#include "photon/surface_tag.h"
 #include "photon/temporal_select.h"
 
 namespace tdpm::estimate {
@@ -90,22 +96,24 @@ class Gatherer {
   const Options& options() const { return opt_; }
 
   template <class Brdf>
-  Rgb radiance(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report = nullptr) {
+  Rgb radiance(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report = nullptr,
+              uint8_t surfaceTag = photon::kNoSurfaceTag) {
     switch (opt_.method) {
-      case Method::Standard: return standard(x, n, wo, brdf, report);
-      case Method::TimeTwoPass: return timeTwoPass(x, n, wo, t, brdf, report);
-      case Method::SpaceTime4D: return spaceTime4D(x, n, wo, t, brdf, report);
+      case Method::Standard: return standard(x, n, wo, brdf, report, surfaceTag);
+      case Method::TimeTwoPass: return timeTwoPass(x, n, wo, t, brdf, report, surfaceTag);
+      case Method::SpaceTime4D: return spaceTime4D(x, n, wo, t, brdf, report, surfaceTag);
     }
     return Rgb(0.0f);
   }
 
   // ---- Standard, eq. (3): L = 1/(pi r^2) sum f_r(x, w_p, w) Q_p K1 / ts ----
   template <class Brdf>
-  Rgb standard(Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, Report* report = nullptr) {
+  Rgb standard(Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, Report* report = nullptr,
+               uint8_t surfaceTag = photon::kNoSurfaceTag) {
     switch (opt_.spaceKernel) {
-      case SpaceKernel::Uniform: return standardImpl(K1Uniform{}, x, n, wo, brdf, report);
-      case SpaceKernel::Epanechnikov: return standardImpl(K1Epanechnikov{}, x, n, wo, brdf, report);
-      case SpaceKernel::Cone: return standardImpl(K1Cone(opt_.coneK), x, n, wo, brdf, report);
+      case SpaceKernel::Uniform: return standardImpl(K1Uniform{}, x, n, wo, brdf, report, surfaceTag);
+      case SpaceKernel::Epanechnikov: return standardImpl(K1Epanechnikov{}, x, n, wo, brdf, report, surfaceTag);
+      case SpaceKernel::Cone: return standardImpl(K1Cone(opt_.coneK), x, n, wo, brdf, report, surfaceTag);
     }
     return Rgb(0.0f);
   }
@@ -113,18 +121,19 @@ class Gatherer {
   // ---- Time-dependent two-pass, eq. (9) with kernels:
   //      L = 1/(pi r^2 h N) sum f_r Q_p K1(|x_p - x|/r) K2((t_p - t)/h) ----
   template <class Brdf>
-  Rgb timeTwoPass(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report = nullptr) {
+  Rgb timeTwoPass(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report = nullptr,
+                  uint8_t surfaceTag = photon::kNoSurfaceTag) {
     bool epa = opt_.timeKernel == TimeKernel::Epanechnikov;
     switch (opt_.spaceKernel) {
       case SpaceKernel::Uniform:
-        return epa ? twoPassImpl<K2Epanechnikov>(K1Uniform{}, x, n, wo, t, brdf, report)
-                   : twoPassImpl<K2Uniform>(K1Uniform{}, x, n, wo, t, brdf, report);
+        return epa ? twoPassImpl<K2Epanechnikov>(K1Uniform{}, x, n, wo, t, brdf, report, surfaceTag)
+                   : twoPassImpl<K2Uniform>(K1Uniform{}, x, n, wo, t, brdf, report, surfaceTag);
       case SpaceKernel::Epanechnikov:
-        return epa ? twoPassImpl<K2Epanechnikov>(K1Epanechnikov{}, x, n, wo, t, brdf, report)
-                   : twoPassImpl<K2Uniform>(K1Epanechnikov{}, x, n, wo, t, brdf, report);
+        return epa ? twoPassImpl<K2Epanechnikov>(K1Epanechnikov{}, x, n, wo, t, brdf, report, surfaceTag)
+                   : twoPassImpl<K2Uniform>(K1Epanechnikov{}, x, n, wo, t, brdf, report, surfaceTag);
       case SpaceKernel::Cone:
-        return epa ? twoPassImpl<K2Epanechnikov>(K1Cone(opt_.coneK), x, n, wo, t, brdf, report)
-                   : twoPassImpl<K2Uniform>(K1Cone(opt_.coneK), x, n, wo, t, brdf, report);
+        return epa ? twoPassImpl<K2Epanechnikov>(K1Cone(opt_.coneK), x, n, wo, t, brdf, report, surfaceTag)
+                   : twoPassImpl<K2Uniform>(K1Cone(opt_.coneK), x, n, wo, t, brdf, report, surfaceTag);
     }
     return Rgb(0.0f);
   }
@@ -132,7 +141,8 @@ class Gatherer {
   // ---- 4D: L = 1/V sum f_r Q_p over the k nearest in |dx|^2 + kappa dt^2,
   //      V = clippedEllipsoidVolume(d^2, kappa, a, b) ----
   template <class Brdf>
-  Rgb spaceTime4D(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report = nullptr);
+  Rgb spaceTime4D(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report = nullptr,
+                  uint8_t surfaceTag = photon::kNoSurfaceTag);
 
  private:
   // Radius^2 of the search ball per the rule in the header comment.
@@ -141,9 +151,10 @@ class Gatherer {
     return r2 > opt_.minRadius2 ? r2 : opt_.minRadius2;
   }
   template <class K1, class Brdf>
-  Rgb standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, Report* report);
+  Rgb standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, Report* report, uint8_t surfaceTag);
   template <class K2, class K1, class Brdf>
-  Rgb twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report);
+  Rgb twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report,
+                  uint8_t surfaceTag);
 
   const photon::KdTree* tree_;
   Options opt_;
@@ -155,7 +166,8 @@ class Gatherer {
 // ---------------------------------------------------------------------------
 
 template <class K1, class Brdf>
-Rgb Gatherer::standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, Report* report) {
+Rgb Gatherer::standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, Report* report,
+                           uint8_t surfaceTag) {
   const photon::PhotonStore& s = tree_->store();
   float maxR2 = opt_.maxRadius * opt_.maxRadius;
   int found = tree_->knn(x, opt_.k, maxR2, query_);
@@ -172,11 +184,13 @@ Rgb Gatherer::standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, 
   const float* d2 = query_.dist2();
   const uint16_t* dirs = s.directions();
   const uint32_t* energies = s.energies();
+  const uint16_t* flags = s.flags();
   Rgb sum(0.0f);
   for (int i = 0; i < found; ++i) {
     uint32_t p = idx[i];
     Vec3f wi = photon::decodeDirection(dirs[p]);
     if (!(dot(n, wi) > 0.0f)) continue;
+    if (photon::otherSideOfSameSurface(uint8_t(flags[p] >> photon::kUserShift), surfaceTag)) continue;
     sum += brdf(wi, wo) * photon::decodeRgbe(energies[p]) * k1(std::min(d2[i] * invR2, 1.0f));
     if (report) report->used.push_back(p);
   }
@@ -190,7 +204,8 @@ Rgb Gatherer::standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, 
 }
 
 template <class K2, class K1, class Brdf>
-Rgb Gatherer::twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report) {
+Rgb Gatherer::twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report,
+                          uint8_t surfaceTag) {
   const photon::PhotonStore& s = tree_->store();
   const photon::TimeQuantiser& tq = s.time();
   float maxR2 = opt_.maxRadius * opt_.maxRadius;
@@ -256,6 +271,7 @@ Rgb Gatherer::twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf
     uint32_t p = idx[i];
     Vec3f wi = photon::decodeDirection(dirs[p]);
     if (!(dot(n, wi) > 0.0f)) continue;
+    if (photon::otherSideOfSameSurface(uint8_t(flags[p] >> photon::kUserShift), surfaceTag)) continue;
     float delta = n.x * (px[p] - x.x) + n.y * (py[p] - x.y) + n.z * (pz[p] - x.z);
     float slice2 = std::max(r2 - delta * delta, minSlice2);
     float rho2 = std::max(d2[i] - delta * delta, 0.0f);
@@ -274,7 +290,8 @@ Rgb Gatherer::twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf
 }
 
 template <class Brdf>
-Rgb Gatherer::spaceTime4D(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report) {
+Rgb Gatherer::spaceTime4D(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report,
+                          uint8_t surfaceTag) {
   const photon::PhotonStore& s = tree_->store();
   const photon::TimeQuantiser& tq = s.time();
   t = std::min(std::max(t, tq.t0), tq.t1);
@@ -300,6 +317,7 @@ Rgb Gatherer::spaceTime4D(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf,
     qmax = std::max(qmax, q);
     Vec3f wi = photon::decodeDirection(dirs[p]);
     if (!(dot(n, wi) > 0.0f)) continue;
+    if (photon::otherSideOfSameSurface(uint8_t(flags[p] >> photon::kUserShift), surfaceTag)) continue;
     sum += brdf(wi, wo) * photon::decodeRgbe(energies[p]);
     if (report) report->used.push_back(p);
   }

@@ -14,6 +14,7 @@
 #include "core/rng.h"
 #include "core/timer.h"
 #include "math/frame.h"
+#include "photon/surface_tag.h"
 #include "sampling/warp.h"
 #include "scene/bsdf.h"
 
@@ -27,9 +28,13 @@ constexpr uint32_t kPilotBatches = 16;
 // enough work to keep every core busy, small next to a large map.
 constexpr uint64_t kBatchesPerChunk = 256;
 // A scene that stores (almost) nothing must not hang: the pilot gives up
-// after kMaxPilotPaths paths, and the emission is capped at
+// after kMaxPilotPaths paths or kMaxPilotRays rays in one round, whichever
+// comes first (a point light inside a closed mirror sphere bounces every
+// path to the depth limit and stores nothing: 58 s for a black 64x48 image
+// when the pilot was bounded by paths alone), and the emission is capped at
 // kMaxPathsPerPhoton paths per wanted photon (both reported as warnings).
-constexpr uint64_t kMaxPilotPaths = uint64_t(1) << 22;
+constexpr uint64_t kMaxPilotPaths = uint64_t(1) << 20;
+constexpr uint64_t kMaxPilotRays = uint64_t(1) << 21;
 constexpr double kMaxPathsPerPhoton = 1000.0;
 
 // Radical inverse in base 2 with a random XOR scramble: a (0,1)-sequence,
@@ -72,7 +77,7 @@ std::vector<Target> specularTargets(const Scene& scene) {
   std::vector<Target> t;
   for (const SceneObject& o : scene.objects)
     if (scene.materials[o.material].isDeltaOnly())
-      t.push_back({o.sweptBounds.center(), 0.5f * length(o.sweptBounds.diagonal()) * 1.001f + 1e-6f});
+      t.push_back({o.sweptBounds.center(), 0.5f * length(o.sweptBounds.diagonal()) * 1.001f});
   return t;
 }
 
@@ -84,26 +89,80 @@ float coneCos(const Target& t, Vec3f x) {
   return d2 <= r2 ? -1.0f : std::sqrt(1.0f - r2 / d2);
 }
 
-// Direction from x toward the targets; returns the solid-angle density of
-// the mixture at the chosen direction (0: no target).
-float sampleTowardTargets(const std::vector<Target>& targets, Vec3f x, Vec3f uvw, Vec3f& dir) {
+// The cone of directions from x that photon emission samples for one
+// target: the target's own cone, or, for a spot light, the spot's cone when
+// that is the smaller (a 1-degree laser aimed at a mirror whose bounding
+// sphere subtends 16 degrees used to waste 99.6% of its paths: issue 10),
+// or nothing when the two cannot meet. Either choice holds every direction
+// that both leaves the spot and meets the target, so the caustic map's
+// support is unchanged and energies stay exact.
+struct Cone {
+  Vec3f axis;
+  float cosMax = 1.0f;  // -1: every direction
+  bool empty = true;
+  float solidAngle() const { return empty ? 0.0f : 2.0f * kPi * (1.0f - cosMax); }
+  bool contains(Vec3f d) const { return !empty && (cosMax <= -1.0f || dot(d, axis) >= cosMax); }
+};
+
+// Spot: its axis and cosTotal at the emission time; cosTotal = -1 for a
+// point light (no restriction).
+struct EmitterCone {
+  Vec3f axis{0, 0, 1};
+  float cosTotal = -1.0f;
+};
+
+Cone samplingCone(const Target& t, Vec3f x, const EmitterCone& e) {
+  Cone c;
+  c.empty = false;
+  c.cosMax = coneCos(t, x);
+  if (c.cosMax > -1.0f) c.axis = normalize(t.centre - x);
+  if (e.cosTotal <= -1.0f) return c;
+  float spotSolid = 2.0f * kPi * (1.0f - e.cosTotal);
+  if (c.cosMax > -1.0f) {
+    // Disjoint when the angle between the axes exceeds the sum of the half-angles.
+    float between = std::acos(std::min(1.0f, std::max(-1.0f, dot(c.axis, e.axis))));
+    float sum = std::acos(std::min(1.0f, e.cosTotal)) + std::acos(std::min(1.0f, c.cosMax));
+    if (sum < kPi && between > sum * 1.0001f + 1e-6f) {
+      c.empty = true;
+      return c;
+    }
+  }
+  if (spotSolid < c.solidAngle()) {
+    c.axis = e.axis;
+    c.cosMax = e.cosTotal;
+  }
+  return c;
+}
+
+// Direction from x toward the targets (through the emitter's cone); returns
+// the solid-angle density of the mixture at the chosen direction (0: no
+// target). Each target's sampling cone is chosen by its solid angle and
+// sampled uniformly, so the density is the number of cones holding the
+// direction over their total solid angle.
+float sampleTowardTargets(const std::vector<Target>& targets, Vec3f x, const EmitterCone& e, Vec3f uvw,
+                          Vec3f& dir) {
   float total = 0;
-  for (const Target& t : targets) total += 2.0f * kPi * (1.0f - coneCos(t, x));
+  for (const Target& t : targets) total += samplingCone(t, x, e).solidAngle();
   if (!(total > 0)) return 0.0f;
   float pick = uvw.x * total, acc = 0;
   size_t j = 0;
-  for (; j + 1 < targets.size(); ++j) {
-    acc += 2.0f * kPi * (1.0f - coneCos(targets[j], x));
-    if (pick < acc) break;
+  Cone chosen;
+  for (; j < targets.size(); ++j) {
+    chosen = samplingCone(targets[j], x, e);
+    acc += chosen.solidAngle();
+    if (pick < acc && !chosen.empty) break;
   }
-  float cosMax = coneCos(targets[j], x);
+  if (j == targets.size()) {  // round-off at the top end: the last non-empty cone
+    for (size_t k = targets.size(); k-- > 0;) {
+      chosen = samplingCone(targets[k], x, e);
+      if (!chosen.empty) break;
+    }
+  }
+  float cosMax = chosen.cosMax;
   Vec3f local = cosMax <= -1.0f ? squareToUniformSphere({uvw.y, uvw.z}) : squareToUniformCone({uvw.y, uvw.z}, cosMax);
-  dir = cosMax <= -1.0f ? local : Frame(normalize(targets[j].centre - x)).toWorld(local);
+  dir = cosMax <= -1.0f ? local : Frame(chosen.axis).toWorld(local);
   int covering = 0;
-  for (const Target& t : targets) {
-    float c = coneCos(t, x);
-    covering += c <= -1.0f || dot(dir, normalize(t.centre - x)) >= c;
-  }
+  for (const Target& t : targets) covering += samplingCone(t, x, e).contains(dir);
   return float(std::max(covering, 1)) / total;
 }
 
@@ -117,11 +176,13 @@ bool emitTowardTargets(const Light& light, const std::vector<Target>& targets, f
     case Light::Type::Spot: {
       Affine3f m = light.motion.atNormalized(time01);
       Vec3f p = m.point(light.position);
-      float pdf = sampleTowardTargets(targets, p, uvw, out.direction);
+      EmitterCone cone;
+      if (light.type == Light::Type::Spot) cone = {normalize(m.vector(light.direction)), light.cosTotal};
+      float pdf = sampleTowardTargets(targets, p, cone, uvw, out.direction);
       if (!(pdf > 0)) return false;
       Rgb i = light.intensity;
       if (light.type == Light::Type::Spot) {
-        float f = light.spotFalloff(dot(out.direction, normalize(m.vector(light.direction))));
+        float f = light.spotFalloff(dot(out.direction, cone.axis));
         if (f <= 0) return false;
         i = i * f;
       }
@@ -133,7 +194,7 @@ bool emitTowardTargets(const Light& light, const std::vector<Target>& targets, f
       AreaLightFrame fr = areaLightFrame(light, time01);
       if (!(fr.area > 0)) return false;
       Vec3f q = fr.center + fr.edgeX * (rng.uniform() - 0.5f) + fr.edgeZ * (rng.uniform() - 0.5f);
-      float pdf = sampleTowardTargets(targets, q, uvw, out.direction);
+      float pdf = sampleTowardTargets(targets, q, EmitterCone{}, uvw, out.direction);
       float cosT = dot(out.direction, fr.normal);
       if (!(pdf > 0) || cosT <= 0) return false;
       out.origin = q;
@@ -181,8 +242,11 @@ double powerTowardTargets(const Light& light, const std::vector<Target>& targets
     case Light::Type::Point:
     case Light::Type::Spot: {
       Vec3f p = light.motion.atNormalized(0.5f).point(light.position);
-      for (const Target& t : targets) sum += 2.0 * kPi * (1.0 - coneCos(t, p));
+      // Each target's sampling cone is at most the spot's own (see
+      // samplingCone). Disjoint cones are not left out: the light may move
+      // and meet the target at other times.
       double cap = light.type == Light::Type::Spot ? 2.0 * kPi * (1.0 - light.cosTotal) : 4.0 * kPi;
+      for (const Target& t : targets) sum += std::min(2.0 * kPi * (1.0 - coneCos(t, p)), cap);
       return light.intensity.average() * std::min(sum, cap);
     }
     case Light::Type::Area: {
@@ -284,7 +348,9 @@ struct Tracer {
       const Material& mat = scene.materials[scene.objects[hit.object].material];
       if (!mat.isDeltaOnly()) {
         bool store = settings.kind == MapKind::Global || (bounce > 0 && allSpecular);
-        if (store) out.add(hit.p, power * float(energyScale), -dir, time);
+        // The side it arrived on keeps it out of estimates on the other side
+        // of the same object (photon/surface_tag.h).
+        if (store) out.add(hit.p, power * float(energyScale), -dir, time, surfaceTag(hit.object, dot(hit.n, dir) > 0.0f));
         if (settings.kind == MapKind::Caustic) return rays;  // L S+ D ends here
       }
       ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
@@ -362,7 +428,8 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   const char* stage = settings.kind == MapKind::Caustic ? "caustic photons" : "global photons";
 
   // Pilot: how many photons does a path store on average? Grow the pilot
-  // until something is stored or the cap says the scene stores nothing.
+  // (8x a round) until something is stored or a round would exceed the
+  // path or ray budget; then the scene is taken to store nothing.
   uint64_t pilotBatches = kPilotBatches;
   size_t stored = 0;
   uint64_t pilotRays = 0;
@@ -371,14 +438,21 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
     PhotonStore pilot = tracer.traceBatches(pilotBatches, 1.0, Progress{}, stage, 0, &rays);
     pilotRays += rays;
     stored = pilot.size();
-    uint64_t paths = pilotBatches * kPathsPerBatch;
-    if (stored > 0 || paths >= kMaxPilotPaths) break;
-    pilotBatches *= 8;
+    if (stored > 0) break;
+    double raysPerBatch = std::max(1.0, double(rays) / double(pilotBatches));
+    uint64_t next = std::min({pilotBatches * 8, kMaxPilotPaths / kPathsPerBatch,
+                              uint64_t(double(kMaxPilotRays) / raysPerBatch)});
+    if (next <= pilotBatches) break;
+    pilotBatches = next;
   }
   if (stored == 0) {
+    // Zero of n: the rate is below 3 / n at 95% confidence.
+    uint64_t paths = pilotBatches * kPathsPerBatch;
     result.rays = pilotRays;
-    result.warning = std::string(stage) + ": none of " + std::to_string(pilotBatches * kPathsPerBatch) +
-                     " paths stored a photon; the map is empty";
+    result.seconds = timer.seconds();
+    result.warning = std::string(stage) + ": none of " + std::to_string(paths) + " paths (" +
+                     std::to_string(pilotRays) + " rays in all) stored a photon, so fewer than 1 in " +
+                     std::to_string(paths / 3) + " would (95% confidence); the map is empty";
     return result;
   }
   double perPath = double(stored) / double(pilotBatches * kPathsPerBatch);

@@ -127,7 +127,9 @@ void renderPixels(const Scene& scene, const Integrator& integrator, const Sampli
 
 float defaultMaxRadius(const Scene& scene, const RenderOptions& opt) {
   if (std::isfinite(opt.estimate.maxRadius)) return opt.estimate.maxRadius;
-  float diag = scene.bounds.empty() ? 1.0f : length(scene.bounds.diagonal());
+  // Of the scene's diagonal, clipped to a multiple of the view distance
+  // (Scene::extent): a huge floor must not make the search reach metres.
+  float diag = scene.bounds.empty() ? 1.0f : scene.extent();
   return opt.maxRadiusFraction * diag;
 }
 
@@ -272,6 +274,14 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
   st = RenderStats{};
   if (scene.lights.empty() && scene.background.isBlack())
     st.warnings.push_back("the scene has no lights and a black background: the image will be black");
+  size_t dark = 0;
+  for (size_t i = 0; i < scene.lights.size(); ++i)
+    if (emitsNothing(scene.lights[i])) {
+      ++dark;
+      st.warnings.push_back("lights[" + std::to_string(i) + "] has zero power: it adds nothing to the image");
+    }
+  if (dark > 0 && dark == scene.lights.size() && scene.background.isBlack())
+    st.warnings.push_back("every light has zero power and the background is black: the image will be black");
   Film film(scene.camera.width(), scene.camera.height());
   SamplingPlan plan;
   plan.batch = opt.spp;

@@ -183,12 +183,7 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
     s.lights.push_back(std::move(l));
   }
   s.embree_.commit();
-  if (!s.bounds.empty()) {
-    Vec3f d = s.bounds.diagonal();
-    s.sceneScale_ = std::max({std::fabs(s.bounds.lo.x), std::fabs(s.bounds.lo.y), std::fabs(s.bounds.lo.z),
-                              std::fabs(s.bounds.hi.x), std::fabs(s.bounds.hi.y), std::fabs(s.bounds.hi.z),
-                              length(d)});
-  }
+  s.computeScale(desc.camera);
   return scene;
 }
 

@@ -32,6 +32,10 @@ struct Light {
 // Derived constants (intensity from power; spot solid-angle integral).
 void finalizeLight(Light& light);
 
+// A light that adds nothing to any image: zero power (irradiance for a
+// directional light) in every channel. Valid input, but worth a warning.
+inline bool emitsNothing(const Light& light) { return !(light.power.maxComponent() > 0.0f); }
+
 struct AreaLightFrame {
   Vec3f center, edgeX, edgeZ, normal;  // world, at one time; normal = emitting side
   float area;

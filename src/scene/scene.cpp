@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace tdpm {
 
@@ -11,6 +12,22 @@ float Scene::epsilon(Vec3f p) const {
   // the scene's size, so a scene scaled by 1e-3 or 1e3 behaves the same.
   float m = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z), 1e-2f * sceneScale_});
   return 2e-5f * m;
+}
+
+void Scene::computeScale(const scene::CameraDesc& camera) {
+  if (bounds.empty()) return;
+  // The camera's distance to what it looks at, over its keyframes.
+  float view = length(camera.target - camera.position);
+  for (const scene::CameraKeyframe& k : camera.motion) view = std::max(view, length(k.target - k.position));
+  float limit = kViewScales * view;
+  if (!(limit > 0.0f) || !std::isfinite(limit)) limit = std::numeric_limits<float>::infinity();
+  Vec3f d = bounds.diagonal();
+  float diag = length(d);
+  float coords = std::max({std::fabs(bounds.lo.x), std::fabs(bounds.lo.y), std::fabs(bounds.lo.z),
+                           std::fabs(bounds.hi.x), std::fabs(bounds.hi.y), std::fabs(bounds.hi.z)});
+  extent_ = std::min(diag, limit);
+  sceneScale_ = std::min(std::max(coords, diag), limit);
+  if (!(extent_ > 0.0f)) extent_ = std::max(sceneScale_, 1e-30f);
 }
 
 Vec3f Scene::spawnOrigin(Vec3f p, Vec3f n, Vec3f d) const {
