@@ -21,6 +21,7 @@
 #include "import/pbrt_math.h"
 #include "import/pbrt_params.h"
 #include "import/pbrt_tokenizer.h"
+#include "import/scene_json_writer.h"
 
 namespace tdpm::pbrt {
 
@@ -873,7 +874,7 @@ void Importer::lightSource(const std::string& type, const ParamSet& ps, const Lo
       failAt(at, "LightSource \"spot\": a non-uniform scale or shear would distort the cone; not supported");
     l.type = scene::LightDesc::Type::Spot;
     l.position = M.point(from);
-    l.direction = normalize(dir);
+    l.direction = canonicalDirection(normalize(dir));
     l.coneAngle = float(cone);
     l.falloffStart = float(cone - delta);
     float solid = float(2 * kPiD * ((1 - cosS) + (cosS - cosT) / 5));  // tdpm's exact integral of the quartic falloff
@@ -887,7 +888,7 @@ void Importer::lightSource(const std::string& type, const ParamSet& ps, const Lo
     Vec3f dir = M.vector(to - from);
     if (!(length(dir) > 0)) failAt(at, "LightSource \"distant\": from and to coincide");
     l.type = scene::LightDesc::Type::Directional;
-    l.direction = normalize(dir);  // pbrt's light travels from "from" toward "to"
+    l.direction = canonicalDirection(normalize(dir));  // pbrt's light travels from "from" toward "to"
     l.power = L;                   // irradiance on a surface facing the light
   } else if (type == "infinite") {
     if (ps.has("filename") || ps.has("mapname")) failAt(at, "LightSource \"infinite\": an environment map is not supported (constant L only)");
@@ -1049,7 +1050,7 @@ Importer::MotionPlan Importer::planMotion(const Mat ctm[2], const Loc& at, const
     if (mirror_) q = mirrorPose(q);
     scene::TransformDesc d;
     d.translate = q.translate;
-    d.rotate = q.rotate;
+    d.rotate = canonicalRotation(q.rotate);
     d.scale = q.scale;
     plan.keys.times.push_back(t);
     plan.keys.poses.push_back(d);
@@ -1082,7 +1083,7 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
       if (!p || !nearlyUniform(p->scale))
         failAt(rec.at, "Shape \"sphere\" under a non-uniform scale or shear (an ellipsoid) is not supported");
       o.placement.translate = p->translate;
-      o.placement.rotate = p->rotate;
+      o.placement.rotate = canonicalRotation(p->rotate);
       o.placement.scale = p->scale;
     } else {
       for (const auto& k : plan.keys.poses)
@@ -1160,7 +1161,7 @@ void Importer::emitAreaLight(const ShapeRecord& rec, const std::vector<Vec3f>& v
   l.name = what;
   l.areaSize = {l1, l2};
   l.placement.translate = P[0] + (e1 + e2) * 0.5f;
-  l.placement.rotate = quaternionFromMatrix(R);
+  l.placement.rotate = canonicalRotation(quaternionFromMatrix(R));
   l.power = L * float(kPiD * rectArea);  // Lambertian: power = L pi A
   const MaterialSlot& mat = materials_[size_t(rec.material)];
   bool black = mat.interface || (mat.desc.type == scene::MaterialDesc::Type::Diffuse && mat.desc.albedo.color.isBlack());
