@@ -187,3 +187,186 @@ TEST_CASE("pbrt convert: the written JSON parses back to the same description an
     CHECK(sameImage(a, b));
   }
 }
+
+namespace {
+
+const char* kDefaultCameraScene = R"(
+Camera "perspective" "float fov" 50
+Film "image" "integer xresolution" 24 "integer yresolution" 16
+Sampler "random" "integer pixelsamples" 4
+WorldBegin
+LightSource "point" "rgb I" [3 3 3] "point3 from" [1 2 1]
+LightSource "infinite" "rgb L" [0.1 0.1 0.1]
+AttributeBegin
+  Material "matte" "rgb Kd" [0.7 0.2 0.2]
+  Translate 0.8 0.3 4
+  Shape "sphere" "float radius" 0.5
+AttributeEnd
+WorldEnd
+)";
+
+std::string num9(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+// Brightness-weighted centroid (column, row) of an image.
+Vec2f centroid(const Film& f) {
+  double sx = 0, sy = 0, w = 0;
+  for (int y = 0; y < f.height; ++y)
+    for (int x = 0; x < f.width; ++x) {
+      double l = f.color[f.index(x, y)].r;
+      sx += l * (x + 0.5);
+      sy += l * (y + 0.5);
+      w += l;
+    }
+  return {float(sx / w), float(sy / w)};
+}
+
+const char* kSphereAtPlusX = R"(
+Film "image" "integer xresolution" 32 "integer yresolution" 32
+Sampler "random" "integer pixelsamples" 2
+WorldBegin
+LightSource "point" "rgb I" [20 20 20] "point3 from" [1 0 5]
+AttributeBegin
+  Translate 1 0.5 0
+  Shape "sphere" "float radius" 0.4
+AttributeEnd
+)";
+
+}  // namespace
+
+TEST_CASE("pbrt camera and sphere: the same description and image as the equivalent JSON") {
+  scene::SceneDescription d = importText(kDefaultCameraScene);
+  // pbrt's default camera looks down +z with +x to the right: left-handed,
+  // so the import mirrors x; the equivalent JSON is the scene with x negated.
+  float power = 3.0f * float(4 * 3.14159265358979323846);
+  std::string json = std::string(R"({
+    "camera": {"position": [0, 0, 0], "target": [0, 0, 1], "up": [0, 1, 0], "fov": 50, "resolution": [24, 16]},
+    "materials": {"m": {"type": "diffuse", "color": [0.7, 0.2, 0.2]}},
+    "objects": [{"shape": {"type": "sphere", "radius": 0.5}, "material": "m", "transform": {"translate": [-0.8, 0.3, 4]}}],
+    "lights": [{"type": "point", "position": [-1, 2, 1], "power": )") + num9(power) + R"(}],
+    "background": [0.1, 0.1, 0.1],
+    "render": {"method": "pathtrace", "spp": 4, "max_depth": 5}})";
+  scene::SceneDescription j = scene::parseScene(json, "equivalent.json");
+  CHECK(d.camera.fovDegrees == 50.0f);
+  CHECK(d.render.spp == 4);
+  CHECK(d.render.maxDepth == 5);
+  CHECK(*d.render.method == "pathtrace");
+  REQUIRE(d.lights.size() == 1);
+  CHECK(d.lights[0].power.r == j.lights[0].power.r);
+  Film a = renderDesc(d), b = renderDesc(j);
+  CHECK(sum(a) > 0);
+  CHECK(sameImage(a, b));
+}
+
+TEST_CASE("pbrt handedness: a sphere on +x appears where pbrt's camera definition puts it") {
+  // pbrt's LookAt: camera +x = normalize(cross(up, dir)) is the image's right
+  // (raster x grows with camera x), +y is up. Looking down -z from +z with
+  // up +y, cross(up, dir) = -x: world +x is on the image's LEFT. The
+  // projection of the sphere's centre (1, 0.5, 0) from (0, 0, 5) with fov 40
+  // on a square image: column (1 + x_cam / (z tan 20deg)) * 16 with
+  // x_cam = -1, z = 5, and row (1 - 0.5 / (5 tan 20deg)) * 16.
+  double t = std::tan(20.0 * 3.14159265358979323846 / 180.0);
+  double col = (1 - 1 / (5 * t)) * 16, row = (1 - 0.5 / (5 * t)) * 16;
+  std::string camera = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\n";
+  Vec2f c = centroid(renderDesc(importText(camera + kSphereAtPlusX)));
+  CHECK(c.x == doctest::Approx(col).epsilon(0.08));
+  CHECK(c.y == doctest::Approx(row).epsilon(0.08));
+  CHECK(c.x < 16);  // left half
+  // A scene that flips x before LookAt (common in exported scenes) has its
+  // camera +x along world +x: the sphere is on the right.
+  Vec2f m = centroid(renderDesc(importText("Scale -1 1 1\n" + camera + kSphereAtPlusX)));
+  CHECK(m.x == doctest::Approx(32 - col).epsilon(0.08));
+  CHECK(m.y == doctest::Approx(row).epsilon(0.08));
+  // The default camera (identity: looking down +z, +x right).
+  Vec2f d = centroid(renderDesc(importText("Translate 0 0 4\nCamera \"perspective\" \"float fov\" 40\n" + std::string(kSphereAtPlusX))));
+  CHECK(d.x > 16);
+}
+
+TEST_CASE("pbrt motion: ActiveTransform poses become keyframes equal to the JSON ones") {
+  std::string pbrtScene = R"(
+Camera "perspective" "float fov" 50
+Film "image" "integer xresolution" 24 "integer yresolution" 16
+Sampler "random" "integer pixelsamples" 4
+WorldBegin
+LightSource "point" "rgb I" [3 3 3] "point3 from" [0 2 1]
+AttributeBegin
+  ActiveTransform StartTime
+  Translate -1 0 4
+  ActiveTransform EndTime
+  Translate 1 0 4
+  Rotate 90 0 0 1
+  ActiveTransform All
+  Shape "trianglemesh" "point3 P" [-0.4 -0.4 0  0.4 -0.4 0  0 0.4 0.2] "integer indices" [0 1 2]
+AttributeEnd
+)";
+  scene::SceneDescription d = importText(pbrtScene, kData + "/motion.pbrt");
+  REQUIRE(d.objects.size() == 1);
+  const scene::MotionDesc& m = d.objects[0].motion;
+  REQUIRE(m.times.size() == 2);
+  CHECK(m.times[0] == 0.0f);
+  CHECK(m.times[1] == 1.0f);
+  // pbrt interpolates T linearly and R by slerp: at t = 0.5 the triangle is
+  // Translate(0, 0, 4) Rotate(45 deg about z); the import mirrors x.
+  std::vector<MotionKey> keys;
+  for (size_t i = 0; i < 2; ++i) keys.push_back({m.times[i], m.poses[i].translate, m.poses[i].rotate, m.poses[i].scale});
+  Affine3f mid = Motion::poseAt(MotionKey{}, keys, 0.5f);
+  double c = std::cos(3.14159265358979323846 / 4), s = std::sin(3.14159265358979323846 / 4);
+  for (Vec3f v : d.objects[0].shape.vertices) {
+    Vec3f expect{float(-(c * v.x - s * v.y)), float(s * v.x + c * v.y), v.z + 4};
+    Vec3f got = mid.point(v);
+    CHECK(got.x == doctest::Approx(expect.x).epsilon(1e-5));
+    CHECK(got.y == doctest::Approx(expect.y).epsilon(1e-5));
+    CHECK(got.z == doctest::Approx(expect.z).epsilon(1e-5));
+  }
+  std::string json = R"({
+    "camera": {"position": [0, 0, 0], "target": [0, 0, 1], "up": [0, 1, 0], "fov": 50, "resolution": [24, 16]},
+    "materials": {"m": {"type": "diffuse", "color": 0.5}},
+    "objects": [{"shape": {"type": "mesh", "file": "motion_tri.obj"}, "material": "m",
+                 "motion": [{"time": 0, "translate": [1, 0, 4], "scale": [-1, 1, 1]},
+                            {"time": 1, "translate": [-1, 0, 4], "rotate": {"axis": [0, 0, 1], "angle": -90},
+                             "scale": [-1, 1, 1]}]}],
+    "lights": [{"type": "point", "position": [0, 2, 1], "power": )" + num9(3.0f * float(4 * 3.14159265358979323846)) + R"(}],
+    "render": {"method": "pathtrace", "spp": 4, "max_depth": 5}})";
+  scene::SceneDescription j = scene::parseScene(json, kData + "/motion.json");
+  Film a = renderDesc(d), b = renderDesc(j);
+  CHECK(sum(a) > 0);
+  CHECK(sameImage(a, b));
+}
+
+TEST_CASE("pbrt motion: TransformTimes and the shutter clip the keyframes; a static scene has none") {
+  std::string head = R"(
+TransformTimes 0 1
+Camera "perspective" "float shutteropen" 0.25 "float shutterclose" 0.75
+WorldBegin
+ActiveTransform EndTime
+Translate 2 0 0
+ActiveTransform All
+)";
+  scene::SceneDescription d = importText(head + "Shape \"sphere\"\n");
+  REQUIRE(d.objects[0].motion.times.size() == 2);
+  CHECK(d.objects[0].motion.times[0] == 0.25f);
+  CHECK(d.objects[0].motion.times[1] == 0.75f);
+  CHECK(d.objects[0].motion.poses[0].translate.x == doctest::Approx(-0.5f));  // mirrored x
+  CHECK(d.objects[0].motion.poses[1].translate.x == doctest::Approx(-1.5f));
+  CHECK(d.camera.shutterOpen == 0.25f);
+  // Motion entirely after the shutter: the start pose holds (pbrt's rule).
+  scene::SceneDescription late = importText("TransformTimes 2 3\n" + head.substr(head.find("Camera")) + "Shape \"sphere\"\n");
+  CHECK(late.objects[0].motion.empty());
+  CHECK(late.objects[0].placement.translate.x == 0.0f);
+  // A camera that translates during the shutter: two camera keyframes.
+  scene::SceneDescription cam = importText(R"(
+ActiveTransform StartTime
+Translate 0 0 0
+ActiveTransform EndTime
+Translate -1 0 0
+ActiveTransform All
+Camera "perspective"
+WorldBegin
+Shape "sphere"
+)");
+  REQUIRE(cam.camera.motion.size() == 2);
+  CHECK(cam.camera.motion[1].position.x == doctest::Approx(-1.0f));  // camera at pbrt +1, mirrored
+}
