@@ -370,3 +370,282 @@ Shape "sphere"
   REQUIRE(cam.camera.motion.size() == 2);
   CHECK(cam.camera.motion[1].position.x == doctest::Approx(-1.0f));  // camera at pbrt +1, mirrored
 }
+
+TEST_CASE("pbrt lights: intensities, radiances, v4 scale/power and the infinite background map exactly") {
+  const double pi = 3.14159265358979323846;
+  scene::SceneDescription d = importText(R"(
+Scale -1 1 1
+Camera "perspective"
+WorldBegin
+LightSource "point" "rgb I" [1 2 3] "point3 from" [0 1 0] "float scale" 2
+LightSource "point" "rgb I" [1 1 1] "float power" 100
+LightSource "spot" "rgb I" [4 4 4] "point3 from" [0 3 0] "point3 to" [0 0 0] "float coneangle" 30 "float conedeltaangle" 0
+LightSource "distant" "rgb L" [0.5 0.5 0.5] "point3 from" [0 1 0] "point3 to" [0 0 0]
+LightSource "infinite" "rgb L" [0.2 0.3 0.4]
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [2 2 2]
+  Translate 0 2 0
+  Rotate 90 1 0 0
+  Shape "trianglemesh" "point3 P" [-1 -0.5 0  1 -0.5 0  1 0.5 0  -1 0.5 0] "integer indices" [0 1 2 0 2 3]
+AttributeEnd
+)");
+  REQUIRE(d.lights.size() == 5);
+  CHECK(d.lights[0].power.g == doctest::Approx(2 * 2 * 4 * pi));  // I * scale * 4 pi
+  CHECK(d.lights[0].position.y == 1.0f);
+  CHECK(d.lights[1].power.r == doctest::Approx(100.0));  // v4 power: the total, whatever I is
+  const auto& spot = d.lights[2];
+  CHECK(spot.direction.y == doctest::Approx(-1.0f));
+  CHECK(spot.falloffStart == 30.0f);
+  CHECK(spot.power.r == doctest::Approx(4 * 2 * pi * (1 - std::cos(pi / 6))));  // hard-edged cone
+  CHECK(d.lights[3].type == scene::LightDesc::Type::Directional);
+  CHECK(d.lights[3].direction.y == doctest::Approx(-1.0f));  // travels from "from" to "to"
+  CHECK(d.lights[3].power.r == 0.5f);
+  CHECK(d.background.b == 0.4f);
+  const auto& area = d.lights[4];
+  CHECK(area.type == scene::LightDesc::Type::Area);
+  CHECK(area.areaSize.x == doctest::Approx(2.0f));
+  CHECK(area.areaSize.y == doctest::Approx(1.0f));
+  CHECK(area.power.r == doctest::Approx(2 * pi * 2));  // L pi A
+  // Rotate 90 about x turns the quad's +z normal to -y: it emits downward,
+  // i.e. tdpm's local -y must stay world -y.
+  Affine3f pl = area.placement.matrix();
+  Vec3f emit = pl.vector({0, -1, 0});
+  CHECK(emit.y == doctest::Approx(-1.0f));
+}
+
+TEST_CASE("pbrt area lights emit on the side of pbrt's surface normal") {
+  auto floorLight = [&](const std::string& rotate) {
+    return sum(renderDesc(importText(R"(
+LookAt 0 0.3 6  0 0 0  0 1 0
+Camera "perspective" "float fov" 8
+Film "image" "integer xresolution" 16 "integer yresolution" 16
+Sampler "random" "integer pixelsamples" 2
+WorldBegin
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [5 5 5]
+  Translate 0 1 0
+  )" + rotate + R"(
+  Shape "bilinearmesh" "point3 P" [-0.5 -0.5 0  0.5 -0.5 0  -0.5 0.5 0  0.5 0.5 0]
+AttributeEnd
+Shape "trianglemesh" "point3 P" [-3 0 -3  3 0 -3  3 0 3  -3 0 3] "integer indices" [0 1 2 0 2 3]
+)")));
+  };
+  // The camera sees only the floor (the light is above the field of view).
+  double down = floorLight("Rotate 90 1 0 0"), up = floorLight("Rotate -90 1 0 0");
+  CHECK(down > 20 * up);
+}
+
+TEST_CASE("pbrt materials map onto tdpm's, approximations as documented") {
+  using T = scene::MaterialDesc::Type;
+  auto material = [&](const std::string& m) {
+    scene::SceneDescription d = importText("WorldBegin\n" + m + "\nShape \"sphere\"\n");
+    REQUIRE(d.objects.size() == 1);
+    return d.materials[d.objects[0].material];
+  };
+  CHECK(material("").albedo.color.r == 0.5f);  // pbrt's default material
+  CHECK(material("Material \"matte\" \"color Kd\" [0.1 0.2 0.3]").albedo.color.b == 0.3f);
+  CHECK(material("Material \"diffuse\" \"float reflectance\" 0.25").albedo.color.g == 0.25f);
+  auto mirror = material("Material \"mirror\"");
+  CHECK(mirror.type == T::Mirror);
+  CHECK(mirror.specular.r == 0.9f);
+  auto glass = material("Material \"glass\" \"float eta\" 1.33 \"rgb Kr\" [0.9 0.9 0.9] \"rgb Kt\" [0.9 0.9 0.9]");
+  CHECK(glass.type == T::Dielectric);
+  CHECK(glass.ior == 1.33f);
+  CHECK(glass.specular.r == 0.9f);
+  // Conductor: reflectance at normal incidence ((eta-1)^2 + k^2) / ((eta+1)^2 + k^2).
+  auto metal = material("Material \"conductor\" \"rgb eta\" [0.2 0.2 0.2] \"rgb k\" [3 3 3] \"float roughness\" 0.09");
+  CHECK(metal.type == T::Metal);
+  CHECK(metal.specular.r == doctest::Approx((0.64 + 9) / (1.44 + 9)));
+  CHECK(metal.roughness == doctest::Approx(0.3));  // v4: alpha = sqrt(roughness)
+  auto v3metal = material("Material \"metal\" \"rgb eta\" [0.2 0.2 0.2] \"rgb k\" [3 3 3] \"float roughness\" 0.3 \"bool remaproughness\" \"false\"");
+  CHECK(v3metal.roughness == doctest::Approx(0.3));
+  CHECK(material("Material \"conductor\" \"rgb reflectance\" [0.8 0.8 0.8]").type == T::Mirror);  // smooth
+  auto plastic = material("Material \"plastic\" \"rgb Kd\" [0.3 0.3 0.3] \"float roughness\" 0.01 \"bool remaproughness\" false");
+  CHECK(plastic.type == T::Plastic);
+  CHECK(plastic.roughness == doctest::Approx(0.01));
+  auto coated = material("Material \"coateddiffuse\" \"rgb reflectance\" [0.3 0.6 0.3] \"float eta\" 1.6");
+  CHECK(coated.ior == 1.6f);
+  CHECK(coated.albedo.color.g == 0.6f);
+  CHECK(material("Texture \"t\" \"float\" \"constant\" \"float value\" 0.7\nMaterial \"diffuse\" \"texture reflectance\" \"t\"")
+            .albedo.color.r == 0.7f);
+  // "" and interface have no surface: the shape is not in the scene.
+  CHECK(importText("WorldBegin\nMaterial \"interface\"\nShape \"sphere\"\n").objects.empty());
+  CHECK(importText("WorldBegin\nMakeNamedMaterial \"air\" \"string type\" \"\"\nNamedMaterial \"air\"\nShape \"sphere\"\n")
+            .objects.empty());
+}
+
+TEST_CASE("pbrt statements: Include/Import relative to the including file, instancing, named coordinate systems, attributes") {
+  scene::SceneDescription inc = pbrt::importPbrtFile(kData + "/include_main.pbrt").scene;
+  CHECK(inc.lights.size() == 2);  // one from parts/lights.pbrt, one from parts/more_lights.pbrt it imports
+  CHECK(inc.objects.size() == 1);
+  scene::SceneDescription d = importText(R"(
+Scale -1 1 1
+Camera "perspective"
+Film "image" "integer xresolution" 8 "integer yresolution" 4 "string filename" "out/picture.png"
+Sampler "stratified" "integer xsamples" 3 "integer ysamples" 2
+Integrator "sppm" "integer numiterations" 10 "integer photonsperiteration" 1000 "float radius" 0.25 "integer maxdepth" 7
+WorldBegin
+ObjectBegin "pair"
+  Translate 1 0 0
+  Shape "sphere" "float radius" 0.25
+  Translate -2 0 0
+  Shape "sphere" "float radius" 0.25
+ObjectEnd
+AttributeBegin
+  Translate 0 0 5
+  CoordinateSystem "five"
+  ObjectInstance "pair"
+AttributeEnd
+TransformBegin
+  CoordSysTransform "five"
+  Translate 0 1 0
+  ObjectInstance "pair"
+TransformEnd
+ObjectInstance "pair"
+)");
+  REQUIRE(d.objects.size() == 6);
+  CHECK(d.objects[0].placement.translate.x == 1.0f);
+  CHECK(d.objects[0].placement.translate.z == 5.0f);
+  CHECK(d.objects[1].placement.translate.x == -1.0f);
+  CHECK(d.objects[2].placement.translate.y == 1.0f);
+  CHECK(d.objects[2].placement.translate.z == 5.0f);
+  CHECK(d.objects[4].placement.translate.z == 0.0f);  // the attribute block restored the CTM
+  CHECK(d.render.spp == 6);
+  CHECK(*d.render.method == "time");
+  CHECK(*d.render.photons == 10000);
+  CHECK(*d.render.maxRadius == 0.25f);
+  CHECK(*d.render.maxDepth == 7);
+  CHECK(d.camera.width == 8);
+  CHECK(d.camera.fovDegrees == 90.0f);  // pbrt's default; landscape: the vertical one
+  CHECK(*pbrt::importPbrtText("Film \"image\" \"string filename\" \"a.png\"\nWorldBegin\n", "x.pbrt").filmFilename == "a.png");
+  // Portrait: pbrt's fov spans the shorter (horizontal) axis.
+  scene::SceneDescription portrait =
+      importText("Camera \"perspective\" \"float fov\" 60\nFilm \"image\" \"integer xresolution\" 10 \"integer yresolution\" 20\nWorldBegin\n");
+  CHECK(portrait.camera.fovDegrees == doctest::Approx(2 * std::atan(std::tan(3.14159265358979323846 / 6) * 2) * 180 / 3.14159265358979323846));
+}
+
+TEST_CASE("pbrt v3 and v4 spellings of one scene render identically") {
+  std::string v3 = R"(
+LookAt 0 1 5  0 0 0  0 1 0
+Camera "perspective" "float fov" [ 40 ]
+Film "image" "integer xresolution" [ 20 ] "integer yresolution" [ 12 ]
+Sampler "random" "integer pixelsamples" 4
+WorldBegin
+LightSource "point" "color I" [ 4 4 4 ] "point from" [ 0 3 2 ]
+Material "matte" "color Kd" [ 0.6 0.5 0.4 ]
+Shape "trianglemesh" "point P" [ -2 -1 -2  2 -1 -2  2 -1 2  -2 -1 2 ] "integer indices" [ 0 1 2 0 2 3 ]
+Shape "sphere" "float radius" 0.7
+WorldEnd
+)";
+  std::string v4 = R"(
+LookAt 0 1 5  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 20 "integer yresolution" 12
+Sampler "zsobol" "integer pixelsamples" 4
+WorldBegin
+LightSource "point" "rgb I" [ 4 4 4 ] "point3 from" [ 0 3 2 ]
+Material "diffuse" "rgb reflectance" [ 0.6 0.5 0.4 ]
+Shape "bilinearmesh" "point3 P" [ -2 -1 -2  2 -1 -2  -2 -1 2  2 -1 2 ]
+Shape "sphere" "float radius" 0.7
+)";
+  Film a = renderDesc(importText(v3)), b = renderDesc(importText(v4));
+  CHECK(sum(a) > 0);
+  // The bilinear patch is the same square as two triangles but split along
+  // the other diagonal order: compare statistically, not bit for bit.
+  CHECK(std::fabs(sum(a) - sum(b)) < 1e-3 * sum(a));
+  // v4's film scales by exposure time x ISO / 100.
+  scene::SceneDescription half = importText("Camera \"perspective\" \"float shutterclose\" 0.5\nFilm \"rgb\" \"float iso\" 200\nWorldBegin\n"
+                                            "LightSource \"point\" \"rgb I\" [1 1 1]\n");
+  CHECK(half.lights[0].power.r == doctest::Approx(4 * 3.14159265358979323846));
+}
+
+TEST_CASE("pbrt errors name file:line and the statement or parameter") {
+  struct Case {
+    std::string text, expected;
+  };
+  const Case cases[] = {
+      {"WorldBegin\nShape \"cylinder\"\n", "dir/t.pbrt:2: Shape \"cylinder\" is not supported"},
+      {"WorldBegin\n\nShape \"sphere\" \"float zmax\" 0.5\n", "dir/t.pbrt:3: Shape \"sphere\": partial spheres"},
+      {"WorldBegin\nShape \"sphere\" \"float radius\" 1 \"float bogus\" 2\n",
+       "dir/t.pbrt:2: Shape \"sphere\": parameter \"float bogus\": not supported"},
+      {"WorldBegin\nShape \"sphere\" \"integer radius\" 1\n", "dir/t.pbrt:2: Shape \"sphere\": parameter \"integer radius\": expected type float"},
+      {"Camera \"perspective\" \"float lensradius\" 0.1\nWorldBegin\n", "dir/t.pbrt:1: Camera \"perspective\": parameter \"float lensradius\": depth of field"},
+      {"Camera \"orthographic\"\nWorldBegin\n", "dir/t.pbrt:1: Camera \"orthographic\" is not supported"},
+      {"Integrator \"bdpt\"\nWorldBegin\n", "dir/t.pbrt:1: Integrator \"bdpt\" is not supported"},
+      {"WorldBegin\nMaterial \"uber\"\n", "dir/t.pbrt:2: material type \"uber\" is not supported"},
+      {"WorldBegin\nMaterial \"metal\"\n", "dir/t.pbrt:2: metal: give \"rgb eta\" and \"rgb k\""},
+      {"WorldBegin\nMaterial \"matte\" \"spectrum Kd\" [400 0.5 700 0.5]\n", "spectral values are not supported"},
+      {"WorldBegin\nMaterial \"glass\" \"rgb Kr\" [1 1 1] \"rgb Kt\" [0.5 0.5 0.5]\n", "dir/t.pbrt:2: glass: Kr and Kt differ"},
+      {"WorldBegin\nLightSource \"goniometric\"\n", "dir/t.pbrt:2: LightSource \"goniometric\" is not supported"},
+      {"WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.exr\"\n", "dir/t.pbrt:2: LightSource \"infinite\": an environment map"},
+      {"WorldBegin\nAreaLightSource \"diffuse\" \"bool twosided\" true\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 1 1 0 0 1 0] \"integer indices\" [0 1 2 0 2 3]\n",
+       "dir/t.pbrt:2: AreaLightSource: twosided"},
+      {"WorldBegin\nAreaLightSource \"diffuse\"\nShape \"sphere\"\n", "dir/t.pbrt:3: Shape \"sphere\" with an AreaLightSource"},
+      {"WorldBegin\nAreaLightSource \"diffuse\"\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n",
+       "dir/t.pbrt:3: AreaLightSource (dir/t.pbrt:2) on Shape \"trianglemesh\": tdpm's area lights are rectangles"},
+      {"WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 3]\n",
+       "dir/t.pbrt:2: Shape \"trianglemesh\": parameter \"integer indices\": index 3 is out of range"},
+      {"WorldBegin\nShape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 1]\n", "dir/t.pbrt:2: Shape \"bilinearmesh\": patch 0 is not a flat parallelogram"},
+      {"WorldBegin\nScale 2 1 1\nShape \"sphere\"\n", "dir/t.pbrt:3: Shape \"sphere\" under a non-uniform scale"},
+      {"WorldBegin\nReverseOrientation\n", "dir/t.pbrt:2: ReverseOrientation is not supported"},
+      {"WorldBegin\nMakeNamedMedium \"fog\"\n", "dir/t.pbrt:2: statement MakeNamedMedium is not supported"},
+      {"WorldBegin\nAttributeBegin\n", "dir/t.pbrt:2: AttributeBegin without a matching End"},
+      {"WorldBegin\nAttributeEnd\n", "dir/t.pbrt:2: AttributeEnd without a matching AttributeBegin"},
+      {"WorldBegin\nNamedMaterial \"x\"\n", "dir/t.pbrt:2: NamedMaterial: no material named \"x\""},
+      {"WorldBegin\nObjectInstance \"x\"\n", "dir/t.pbrt:2: ObjectInstance: no object named \"x\""},
+      {"WorldBegin\nTranslate 1 2\n", "dir/t.pbrt:2: Translate: expected a number before the end of the file"},
+      {"WorldBegin\nShape \"sphere\" \"float radius\" [ 1\n", "dir/t.pbrt:2: Shape \"sphere\": parameter \"float radius\": missing ']'"},
+      {"Shape \"sphere\"\n", "dir/t.pbrt:1: Shape is only allowed after WorldBegin"},
+      {"WorldBegin\nCamera \"perspective\"\n", "dir/t.pbrt:2: Camera is only allowed before WorldBegin"},
+      {"Camera \"perspective\"\n", "dir/t.pbrt: no WorldBegin"},
+      {"WorldBegin\nTexture \"c\" \"spectrum\" \"checkerboard\"\n", "dir/t.pbrt:2: Texture \"c\": checkerboard is not supported"},
+      {"LookAt 0 0 0  0 0 0  0 1 0\n", "dir/t.pbrt:1: LookAt: eye and look-at point coincide"},
+      {"Camera \"perspective\" \"float fov\" 180\nWorldBegin\n", "dir/t.pbrt:1: Camera: fov must be in (0, 180)"},
+      {"Film \"image\" \"float cropwindow\" [0 0.5 0 1]\nWorldBegin\n", "dir/t.pbrt:1: Film \"image\": parameter \"float cropwindow\": a crop window"},
+      {"ActiveTransform EndTime\nRotate 30 0 1 0\nActiveTransform All\nCamera \"perspective\"\nWorldBegin\n",
+       "dir/t.pbrt:4: Camera: a camera that rotates during the shutter"},
+      {"WorldBegin\nActiveTransform EndTime\nScale 1 2 1\nRotate 30 0 0 1\nActiveTransform All\nShape \"sphere\"\n",
+       "dir/t.pbrt:6: Shape \"sphere\": its EndTime transform has shear"},
+      {"WorldBegin\nShape \"sphere\" \"float radius\" 1e999\n", "dir/t.pbrt:2: number 1e999 is not finite"},
+      {"WorldBegin\n{\n", "dir/t.pbrt:2: unexpected character '{'"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.text);
+    std::string e = errorOf(c.text);
+    CHECK_MESSAGE(e.find(c.expected) != std::string::npos, e);
+  }
+  std::string cycle = kData + "/include_cycle.pbrt";
+  try {
+    pbrt::importPbrtFile(cycle);
+    FAIL("no error");
+  } catch (const Error& e) {
+    CHECK(std::string(e.what()).find("nested more than 32 deep") != std::string::npos);
+    CHECK(std::string(e.what()).find("cycle_a.pbrt:2: Include") != std::string::npos);
+  }
+  try {
+    pbrt::importPbrtFile(kData + "/include_missing.pbrt");
+    FAIL("no error");
+  } catch (const Error& e) {
+    CHECK(std::string(e.what()).find("include_missing.pbrt:3: Include: ") != std::string::npos);
+    CHECK(std::string(e.what()).find("parts/nope.pbrt: cannot read scene file") != std::string::npos);
+  }
+}
+
+TEST_CASE("pbrt import notes: quality-only statements and ignored mesh attributes are one line each") {
+  pbrt::ImportResult r = pbrt::importPbrtText(R"(
+PixelFilter "gaussian"
+Accelerator "bvh"
+ColorSpace "srgb"
+WorldBegin
+Shape "trianglemesh" "point3 P" [0 0 0 1 0 0 0 1 0] "normal N" [0 0 1 0 0 1 0 0 1] "point2 uv" [0 0 1 0 0 1]
+Shape "trianglemesh" "point3 P" [0 0 0 1 0 0 0 1 0] "normal N" [0 0 1 0 0 1 0 0 1]
+)", "n.pbrt");
+  int filters = 0, normals = 0;
+  for (const auto& n : r.notes) {
+    filters += n.find("n.pbrt:2: PixelFilter") == 0;
+    normals += n.find("\"N\" ignored") != std::string::npos;
+  }
+  CHECK(filters == 1);
+  CHECK(normals == 1);
+  CHECK(r.notes.size() == 5);
+}
