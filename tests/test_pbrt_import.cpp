@@ -5,7 +5,10 @@
 // malformed input is an error naming file:line.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +21,7 @@
 #include "core/error.h"
 #include "import/pbrt_import.h"
 #include "import/pbrt_tokenizer.h"
+#include "import/ply_reader.h"
 #include "import/scene_json_writer.h"
 #include "render/renderer.h"
 #include "scene/parse.h"
@@ -648,4 +652,87 @@ Shape "trianglemesh" "point3 P" [0 0 0 1 0 0 0 1 0] "normal N" [0 0 1 0 0 1 0 0 
   CHECK(filters == 1);
   CHECK(normals == 1);
   CHECK(r.notes.size() == 5);
+}
+
+namespace {
+
+// A PLY file in one of the binary encodings: the test's square + triangle.
+std::string binaryPly(bool little, const std::string& extraHeader = "", int64_t faceCount = 2) {
+  std::string h = std::string("ply\nformat ") + (little ? "binary_little_endian" : "binary_big_endian") +
+                  " 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n" + extraHeader +
+                  "element face " + std::to_string(faceCount) + "\nproperty list uchar int vertex_indices\nend_header\n";
+  auto put = [&](const void* p, size_t n) {
+    std::string b(static_cast<const char*>(p), n);
+    uint16_t one = 1;
+    bool hostLittle = *reinterpret_cast<const unsigned char*>(&one) == 1;
+    if (hostLittle != little) std::reverse(b.begin(), b.end());
+    h += b;
+  };
+  const float v[5][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5f, 2, 0}};
+  for (const auto& p : v)
+    for (float c : p) put(&c, 4);
+  const std::vector<std::vector<int32_t>> faces = {{0, 1, 2, 3}, {3, 2, 4}};
+  for (const auto& f : faces) {
+    unsigned char n = static_cast<unsigned char>(f.size());
+    h += char(n);
+    for (int32_t i : f) put(&i, 4);
+  }
+  return h;
+}
+
+}  // namespace
+
+TEST_CASE("pbrt plymesh: ASCII and binary (both endians) read to the same triangles") {
+  scene::SceneDescription d = pbrt::importPbrtFile(kData + "/plymesh.pbrt").scene;
+  REQUIRE(d.objects.size() == 1);
+  const auto& s = d.objects[0].shape;
+  REQUIRE(s.vertices.size() == 5);
+  CHECK(s.indices.size() == 9);  // the quad as two triangles, then the triangle
+  CHECK(s.vertices[4].y == 2.0f);
+  CHECK(s.vertices[1].x == -1.0f);  // mirrored world
+  for (bool little : {true, false}) {
+    CAPTURE(little);
+    pbrt::PlyMesh m = pbrt::parsePly(binaryPly(little), "b.ply");
+    REQUIRE(m.vertices.size() == 5);
+    CHECK(m.vertices[4].x == 0.5f);
+    CHECK(m.vertices[4].y == 2.0f);
+    CHECK(m.quads == std::vector<uint32_t>{0, 1, 2, 3});
+    CHECK(m.triangles == std::vector<uint32_t>{3, 2, 4});
+  }
+}
+
+TEST_CASE("pbrt plymesh: hostile files are refused with a reason, never a crash or a huge allocation") {
+  auto err = [](const std::string& bytes) {
+    try {
+      pbrt::parsePly(bytes, "h.ply");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  std::string good = binaryPly(true);
+  CHECK(err(good) == "(no error)");
+  CHECK(err("plx\n") .find("h.ply: not a PLY file") == 0);
+  CHECK(err(good.substr(0, good.size() - 3)).find("truncated") != std::string::npos);
+  CHECK(err(binaryPly(true, "", 4000000000LL)).find("more than the file can hold") != std::string::npos);
+  std::string badIndex = good;
+  badIndex[badIndex.size() - 4] = 9;  // last triangle index -> 9 (little endian low byte)
+  CHECK(err(badIndex).find("uses vertex 9") != std::string::npos);
+  std::string nan = good;
+  size_t body = nan.find("end_header\n") + 11;
+  const float q = std::numeric_limits<float>::quiet_NaN();
+  std::memcpy(&nan[body], &q, 4);
+  CHECK(err(nan).find("vertex 0 is not finite") != std::string::npos);
+  CHECK(err("ply\nformat ascii 2.0\nend_header\n").find("unsupported PLY version") != std::string::npos);
+  CHECK(err("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 x\n")
+            .find("'x' is not a number") != std::string::npos);
+  CHECK(err("ply\nformat ascii 1.0\nelement vertex 1\nproperty list uchar float x\nend_header\n1 2\n").find("is a list") != std::string::npos);
+  CHECK(err("ply\nformat ascii 1.0\nbogus\nend_header\n").find("unknown header line 'bogus'") != std::string::npos);
+  std::string pentagon = "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+                         "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 2 0\n5 0 1 2 3 4\n";
+  CHECK(err(pentagon).find("has 5 corners") != std::string::npos);
+  // A missing PLY file: the Shape statement's line and the file name.
+  std::string e = errorOf("WorldBegin\n\nShape \"plymesh\" \"string filename\" \"nope.ply\"\n", kData + "/x.pbrt");
+  CHECK(e.find("x.pbrt:3: Shape \"plymesh\": ") != std::string::npos);
+  CHECK(e.find("nope.ply: cannot read PLY file") != std::string::npos);
 }

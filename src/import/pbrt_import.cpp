@@ -21,6 +21,7 @@
 #include "import/pbrt_math.h"
 #include "import/pbrt_params.h"
 #include "import/pbrt_tokenizer.h"
+#include "import/ply_reader.h"
 #include "import/scene_json_writer.h"
 
 namespace tdpm::pbrt {
@@ -54,6 +55,21 @@ std::string readWholeFile(const std::string& path, const std::string& where) {
   text << in.rdbuf();
   if (in.bad()) throw Error(where + path + ": error while reading scene file");
   return text.str();
+}
+
+// A relative path is looked up beside the file that names it; if it is not
+// there but is beside the main scene file (pbrt's search directory), that
+// one is used, so scenes written for pbrt's rule load too.
+std::string resolvePath(const std::string& name, const std::string& namingFile, const std::string& mainDir) {
+  std::filesystem::path p(name);
+  if (p.is_absolute()) return p.lexically_normal().string();
+  std::filesystem::path local = (std::filesystem::path(namingFile).parent_path() / p).lexically_normal();
+  std::error_code ec;
+  if (!std::filesystem::exists(local, ec) && !mainDir.empty()) {
+    std::filesystem::path main = (std::filesystem::path(mainDir) / p).lexically_normal();
+    if (std::filesystem::exists(main, ec)) return main.string();
+  }
+  return local.string();
 }
 
 // ------------------------------------------------------------ state types
@@ -194,6 +210,7 @@ class Importer {
   }
   void parseText(const std::string& text, const std::string& file, int depth);
   void finish(const std::string& file);
+  std::string mainDir;  // pbrt's search directory: the main scene file's
 
  private:
   // statements
@@ -382,9 +399,7 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
   } else if (s == "Include" || s == "Import") {
     std::string name = c.string(s);
     if (depth + 1 > kMaxIncludeDepth) failAt(at, s + " \"" + name + "\": nested more than 32 deep (an include cycle?)");
-    std::filesystem::path p(name);
-    if (!p.is_absolute()) p = std::filesystem::path(c.file()).parent_path() / p;
-    parseFile(p.lexically_normal().string(), depth + 1, at.str() + ": " + s + ": ");
+    parseFile(resolvePath(name, c.file(), mainDir), depth + 1, at.str() + ": " + s + ": ");
   } else if (s == "Shape") {
     requireWorld(at, s);
     std::string type = c.string(s);
@@ -957,7 +972,21 @@ std::vector<uint32_t> readIndices(const ParamSet& ps, size_t vertexCount, size_t
   return out;
 }
 
-Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(const std::string&)>& note) {
+// Appends quads (a, b, c, d in the file's corner order) as two triangles:
+// exact only for flat parallelograms, where pbrt-v3's triangle split and
+// pbrt-v4's bilinear patch agree.
+void addQuads(const std::vector<Vec3f>& P, const std::vector<uint32_t>& quads, const Loc& at, const std::string& what,
+              std::vector<uint32_t>* triangles) {
+  for (size_t i = 0; i < quads.size(); i += 4) {
+    Vec3f a = P[quads[i]], b = P[quads[i + 1]], c = P[quads[i + 2]], d = P[quads[i + 3]];
+    float scale = std::max({length(b - a), length(d - a), 1e-30f});
+    if (length((a + c) - (b + d)) > 1e-5f * scale)
+      failAt(at, what + ": quad " + std::to_string(i / 4) + " is not a flat parallelogram (pbrt-v3 and v4 would render it differently)");
+    triangles->insert(triangles->end(), {quads[i], quads[i + 1], quads[i + 2], quads[i], quads[i + 2], quads[i + 3]});
+  }
+}
+
+Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(const std::string&)>& note, const std::string& mainDir) {
   const ParamSet& ps = rec.params;
   Geometry g;
   if (rec.type == "sphere") {
@@ -994,9 +1023,23 @@ Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(const std
       }
     }
   } else if (rec.type == "plymesh") {
-    failAt(rec.at, "Shape \"plymesh\" is not supported yet (convert the mesh to a trianglemesh)");
+    std::string file = ps.getString("filename", "");
+    if (file.empty()) failAt(rec.at, "Shape \"plymesh\": missing parameter \"string filename\"");
+    if (ps.has("displacement")) failAt(rec.at, "Shape \"plymesh\": displacement is not supported");
+    ps.markUsed("edgelength");
+    PlyMesh ply;
+    try {
+      ply = readPly(resolvePath(file, rec.at.file, mainDir));
+    } catch (const Error& e) {
+      failAt(rec.at, std::string("Shape \"plymesh\": ") + e.what());
+    }
+    for (const std::string& q : ply.ignoredProperties)
+      note("Shape \"plymesh\": vertex property \"" + q + "\" ignored (tdpm shades with the geometric normal)");
+    g.vertices = std::move(ply.vertices);
+    g.indices = std::move(ply.triangles);
+    addQuads(g.vertices, ply.quads, rec.at, "Shape \"plymesh\" \"" + file + "\"", &g.indices);
   } else {
-    failAt(rec.at, "Shape \"" + rec.type + "\" is not supported (sphere, trianglemesh, bilinearmesh)");
+    failAt(rec.at, "Shape \"" + rec.type + "\" is not supported (sphere, trianglemesh, bilinearmesh, plymesh)");
   }
   ps.checkAllUsed();
   return g;
@@ -1064,7 +1107,7 @@ bool nearlyUniform(Vec3f s) {
 }
 
 void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& instanceAt) {
-  Geometry g = makeGeometry(rec, [&](const std::string& w) { note(rec.at, w); });
+  Geometry g = makeGeometry(rec, [&](const std::string& w) { note(rec.at, w); }, mainDir);
   const MaterialSlot& mat = materials_[size_t(rec.material)];
   if (rec.area) {
     if (g.sphere) failAt(rec.at, "Shape \"sphere\" with an AreaLightSource: tdpm's area lights are rectangles");
@@ -1189,6 +1232,7 @@ void Importer::finish(const std::string& file) {
 ImportResult importPbrtText(const std::string& text, const std::string& path) {
   Importer im;
   im.result.scene.sourcePath = path;
+  im.mainDir = std::filesystem::path(path).parent_path().string();
   im.parseText(text, path, 0);
   im.finish(path);
   return std::move(im.result);
@@ -1197,6 +1241,7 @@ ImportResult importPbrtText(const std::string& text, const std::string& path) {
 ImportResult importPbrtFile(const std::string& path) {
   Importer im;
   im.result.scene.sourcePath = path;
+  im.mainDir = std::filesystem::path(path).parent_path().string();
   im.parseFile(path, 0, "");
   im.finish(path);
   return std::move(im.result);
