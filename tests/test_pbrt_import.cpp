@@ -22,6 +22,7 @@
 #include "import/pbrt_import.h"
 #include "import/pbrt_tokenizer.h"
 #include "import/ply_reader.h"
+#include "cli_harness.h"
 #include "import/scene_json_writer.h"
 #include "render/renderer.h"
 #include "scene/parse.h"
@@ -735,4 +736,56 @@ TEST_CASE("pbrt plymesh: hostile files are refused with a reason, never a crash 
   std::string e = errorOf("WorldBegin\n\nShape \"plymesh\" \"string filename\" \"nope.ply\"\n", kData + "/x.pbrt");
   CHECK(e.find("x.pbrt:3: Shape \"plymesh\": ") != std::string::npos);
   CHECK(e.find("nope.ply: cannot read PLY file") != std::string::npos);
+}
+
+TEST_CASE("cli: render chooses the pbrt import by extension and names the output after the Film") {
+  std::string dir = test::makeTempDir();
+  test::writeFile(dir + "/scene.pbrt", "LookAt 0 0 5  0 0 0  0 1 0\n" + std::string(kSphereAtPlusX));
+  // Film "filename" without -o: the film's name, as .exr, in the working directory.
+  test::writeFile(dir + "/named.pbrt", "Film \"image\" \"integer xresolution\" 8 \"integer yresolution\" 8 \"string filename\" \"pic.png\"\n"
+                                       "Sampler \"random\" \"integer pixelsamples\" 1\nWorldBegin\nShape \"sphere\"\n");
+  auto r = test::runTdpm("render '" + dir + "/scene.pbrt' -o '" + dir + "/a.exr' --threads 2 -q");
+  INFO(r.output);
+  CHECK(r.exitCode == 0);
+  CHECK(test::fileExists(dir + "/a.exr"));
+  auto n = test::runTdpm("render '" + dir + "/named.pbrt' --threads 2 -q && mv pic.exr pic.png '" + dir + "/'");
+  INFO(n.output);
+  CHECK(n.exitCode == 0);
+  CHECK(test::fileExists(dir + "/pic.exr"));
+  // A located error, exit 1, nothing written.
+  test::writeFile(dir + "/bad.pbrt", "WorldBegin\n\nShape \"disk\"\n");
+  auto b = test::runTdpm("render '" + dir + "/bad.pbrt' -o '" + dir + "/bad.exr' -q");
+  CHECK(b.exitCode == 1);
+  CHECK(b.output.find("bad.pbrt:3: Shape \"disk\" is not supported") != std::string::npos);
+  CHECK(!test::fileExists(dir + "/bad.exr"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("cli: convert writes JSON (+ OBJ) that renders to the same image as the pbrt file") {
+  std::string dir = test::makeTempDir();
+  test::writeFile(dir + "/f.pbrt", kFeatureScene);
+  auto h = test::runTdpm("convert --help");
+  CHECK(h.exitCode == 0);
+  CHECK(h.output.find("--output") != std::string::npos);
+  auto c = test::runTdpm("convert '" + dir + "/f.pbrt' -o '" + dir + "/f.json' -q");
+  INFO(c.output);
+  REQUIRE(c.exitCode == 0);
+  CHECK(test::fileExists(dir + "/f.mesh0.obj"));
+  std::string common = " --threads 2 -q --seed 3 --spp 2";
+  REQUIRE(test::runTdpm("render '" + dir + "/f.pbrt' -o '" + dir + "/p.exr'" + common).exitCode == 0);
+  REQUIRE(test::runTdpm("render '" + dir + "/f.json' -o '" + dir + "/j.exr'" + common).exitCode == 0);
+  auto cmp = test::runTdpm("compare '" + dir + "/p.exr' '" + dir + "/j.exr' --json");
+  INFO(cmp.output);
+  auto metrics = nlohmann::json::parse(cmp.output);
+  CHECK(metrics["max_abs_error"]["overall"] == 0.0);
+  CHECK(metrics["mean_test"]["overall"].get<double>() > 0);
+  // Errors: not pbrt, output not .json, a bad scene (nothing written).
+  CHECK(test::runTdpm("convert '" + dir + "/f.json' -o '" + dir + "/x.json'").exitCode == 1);
+  CHECK(test::runTdpm("convert '" + dir + "/f.pbrt' -o '" + dir + "/x.txt'").exitCode == 1);
+  CHECK(test::runTdpm("convert '" + dir + "/f.pbrt'").exitCode == 2);
+  test::writeFile(dir + "/bad.pbrt", "WorldBegin\nShape \"disk\"\n");
+  auto b = test::runTdpm("convert '" + dir + "/bad.pbrt' -o '" + dir + "/bad.json'");
+  CHECK(b.exitCode == 1);
+  CHECK(!test::fileExists(dir + "/bad.json"));
+  std::filesystem::remove_all(dir);
 }
