@@ -51,6 +51,8 @@ std::string readWholeFile(const std::string& path, const std::string& where) {
   if (std::filesystem::is_directory(path, ec)) throw Error(where + path + ": cannot read scene file: it is a directory");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(where + path + ": cannot read scene file (" + std::strerror(errno) + ")");
+  // Not a device or a pipe (Include "/dev/zero" would never end).
+  if (!std::filesystem::is_regular_file(path, ec)) throw Error(where + path + ": cannot read scene file: not a regular file");
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw Error(where + path + ": error while reading scene file");

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -239,6 +240,8 @@ PlyMesh parsePly(const std::string& bytes, const std::string& name) {
 PlyMesh readPly(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path + ": cannot read PLY file (" + std::strerror(errno) + ")");
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw Error(path + ": cannot read PLY file: not a regular file");
   std::ostringstream s;
   s << in.rdbuf();
   if (in.bad()) throw Error(path + ": error while reading PLY file");
