@@ -613,6 +613,10 @@ TEST_CASE("pbrt errors name file:line and the statement or parameter") {
        "dir/t.pbrt:6: Shape \"sphere\": its EndTime transform has shear"},
       {"WorldBegin\nShape \"sphere\" \"float radius\" 1e999\n", "dir/t.pbrt:2: number 1e999 is not finite"},
       {"WorldBegin\n{\n", "dir/t.pbrt:2: unexpected character '{'"},
+      // found by fuzz_pbrt: a string where a number belongs
+      {"WorldBegin\nLightSource \"spot\" \"float conedeltaangle\" \"x\"\n",
+       "dir/t.pbrt:2: LightSource \"spot\": parameter \"float conedeltaangle\": expected numbers, got \"x\""},
+      {"WorldBegin\nShape \"plymesh\" \"string filename\" 3\n", "expected a quoted string, got a number"},
   };
   for (const Case& c : cases) {
     CAPTURE(c.text);

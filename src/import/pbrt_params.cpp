@@ -34,6 +34,9 @@ const Param& ParamSet::expect(const std::string& name, const std::vector<std::st
   bool typeOk = false;
   for (const auto& t : types) typeOk = typeOk || p->type == t;
   if (!typeOk) fail(*p, "expected type " + joinTypes(types));
+  bool textual = p->type == "string" || p->type == "bool" || p->type == "texture";
+  if (textual && !p->numbers.empty()) fail(*p, "expected a quoted string, got a number");
+  if (!textual && !p->strings.empty()) fail(*p, "expected numbers, got \"" + p->strings[0] + "\"");
   size_t have = p->numbers.size() + p->strings.size();
   if (count && have != count)
     fail(*p, "expected " + std::to_string(count) + " value" + (count > 1 ? "s" : "") + ", got " + std::to_string(have));
