@@ -42,7 +42,7 @@ jobs=$(nproc 2>/dev/null || echo 2)
 start=$(date +%s)
 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ -DTDPM_FUZZ=ON \
   -DTDPM_BUILD_TESTS=OFF -DTDPM_BUILD_BENCH=OFF >/dev/null
-cmake --build build-fuzz -j "$jobs" --target fuzz_scene fuzz_exr
+cmake --build build-fuzz -j "$jobs" --target fuzz_scene fuzz_exr fuzz_pbrt
 echo "fuzz.sh: build took $(( $(date +%s) - start )) s"
 
 work=build-fuzz/run
@@ -50,9 +50,10 @@ rm -rf "$work"
 mkdir -p "$work/scene" "$work/exr"
 cp scenes/*.json tests/data/*.json fuzz/corpus/scene/*.json "$work/scene/" 2>/dev/null || true
 cp fuzz/corpus/exr/*.exr "$work/exr/"
+mkdir -p "$work/pbrt" && cp fuzz/corpus/pbrt/*.pbrt "$work/pbrt/"  # seeds of fuzz_pbrt (pbrt import)
 
 status=0
-for target in scene exr; do
+for target in scene exr pbrt; do
   findings=build-fuzz/findings/$target
   mkdir -p "$findings"
   log=build-fuzz/fuzz_$target.log

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "cli/compare_command.h"
+#include "cli/convert_command.h"
 #include "cli/render_command.h"
 #include "core/error.h"
 
@@ -26,6 +27,8 @@ int run(int argc, char** argv) {
   CLI::App* render = addRenderCommand(app, renderArgs);
   CompareArgs compareArgs;
   CLI::App* compare = addCompareCommand(app, compareArgs);
+  ConvertArgs convertArgs;
+  CLI::App* convert = addConvertCommand(app, convertArgs);
 
   try {
     app.parse(argc, argv);
@@ -39,6 +42,7 @@ int run(int argc, char** argv) {
   try {
     if (render->parsed()) return runRender(renderArgs);
     if (compare->parsed()) return runCompare(compareArgs);
+    if (convert->parsed()) return runConvert(convertArgs);
   } catch (const Error& e) {
     std::fprintf(stderr, "tdpm: error: %s\n", e.what());
     return 1;

@@ -17,6 +17,7 @@
 #include "core/timer.h"
 #include "image/exr.h"
 #include "image/png.h"
+#include "import/pbrt_import.h"
 #include "render/film_output.h"
 #include "render/renderer.h"
 #include "render/threads.h"
@@ -75,6 +76,16 @@ std::string stemOf(const std::string& path) {
 
 bool endsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// pbrt's Film "filename" (often .exr, .png or .pfm): tdpm writes EXR, so
+// the name keeps its directory and stem and gets the .exr extension.
+std::string exrNameForFilm(const std::string& filmName) {
+  if (endsWith(filmName, ".exr")) return filmName;
+  size_t slash = filmName.find_last_of('/');
+  size_t dot = filmName.find_last_of('.');
+  std::string stem = dot == std::string::npos || (slash != std::string::npos && dot < slash) ? filmName : filmName.substr(0, dot);
+  return stem + ".exr";
 }
 
 void parseResolution(const std::string& text, int& w, int& h) {
@@ -246,8 +257,8 @@ void warnAccumulationPhotons(const RenderOptions& o, bool hasMotion, const Rende
 
 CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   CLI::App* c = app.add_subcommand("render", "Render a scene file to an OpenEXR image and a PNG preview");
-  c->add_option("scene", a.scene, "Scene file (JSON, see docs/scene-format.md)")->required();
-  c->add_option("-o,--output", a.output, "Output EXR path (default: <scene name>.exr here); the PNG preview goes beside it. Both are written to "
+  c->add_option("scene", a.scene, "Scene file: JSON (docs/scene-format.md) or pbrt-v3/v4 by the .pbrt extension (docs/pbrt-import.md)")->required();
+  c->add_option("-o,--output", a.output, "Output EXR path (default: <scene name>.exr here, or a pbrt Film's filename as .exr); the PNG preview goes beside it. Both are written to "
                 "temporaries and renamed into place together: on any failure or signal the old pair stays. A "
                 "symbolic link is written through (its target is replaced, keeping its mode); a path that is an input "
                 "(scene, mesh) is refused. Checked before rendering");
@@ -304,15 +315,29 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
 
 int runRender(const RenderArgs& a) {
   Timer total;
-  const std::string output = a.output.empty() ? stemOf(a.scene) + ".exr" : a.output;
+  const bool pbrtScene = pbrt::isPbrtPath(a.scene);
+  std::string output = a.output.empty() ? stemOf(a.scene) + ".exr" : a.output;
   if (a.method && !isRenderMethod(*a.method))
     throw Error("--method: unknown method '" + *a.method + "' (expected " + methodList() + ")");
   int width = 0, height = 0;
   if (a.resolution) parseResolution(*a.resolution, width, height);
-  const std::string preview = image::previewPathFor(output);
-  validateOutput(output, preview, a.scene);
+  std::string preview = image::previewPathFor(output);
+  // A pbrt scene names its own output (Film "filename"), known only once it is read.
+  if (!pbrtScene || !a.output.empty()) validateOutput(output, preview, a.scene);
 
-  scene::SceneDescription desc = scene::loadScene(a.scene);
+  scene::SceneDescription desc;
+  if (pbrtScene) {
+    pbrt::ImportResult imported = pbrt::importPbrtFile(a.scene);
+    for (const std::string& n : imported.notes) std::fprintf(stderr, "tdpm: note: %s\n", n.c_str());
+    if (a.output.empty()) {
+      if (imported.filmFilename) output = exrNameForFilm(*imported.filmFilename);
+      preview = image::previewPathFor(output);
+      validateOutput(output, preview, a.scene);
+    }
+    desc = std::move(imported.scene);
+  } else {
+    desc = scene::loadScene(a.scene);
+  }
   if (a.kappa) {
     // The usable kappa depends on the scene's shutter (scene/limits.h).
     limits::KappaRange r = limits::kappaRange(double(desc.camera.shutterClose) - desc.camera.shutterOpen);

@@ -1,0 +1,155 @@
+// import/pbrt_importer.h — internal to the pbrt import: the importer's
+// graphics state (CTM pair for motion, attribute stack, named materials,
+// textures, coordinate systems and object instances) and the Importer class
+// whose statement half lives in pbrt_import.cpp and whose mapping half
+// (materials, lights, shapes, motion -> SceneDescription) in pbrt_mapping.cpp.
+#pragma once
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "import/pbrt_import.h"
+#include "import/pbrt_math.h"
+#include "import/pbrt_params.h"
+#include "import/pbrt_tokenizer.h"
+
+namespace tdpm::pbrt::detail {
+
+constexpr double kPiD = 3.14159265358979323846;
+
+struct Loc {
+  std::string file;
+  int line = 0;
+  std::string str() const { return file + ":" + std::to_string(line); }
+};
+
+[[noreturn]] void failAt(const Loc& at, const std::string& what);
+std::string fmtNum(double v);
+std::string readWholeFile(const std::string& path, const std::string& where);
+// A relative path is looked up beside the file that names it; if it is not
+// there but is beside the main scene file (pbrt's search directory), that
+// one is used, so scenes written for pbrt's rule load too.
+std::string resolvePath(const std::string& name, const std::string& namingFile, const std::string& mainDir);
+
+struct MaterialSlot {
+  bool interface = false;  // "" / "interface" / "none": no surface at all
+  scene::MaterialDesc desc;
+  int index = -1;  // in scene.materials once a shape uses it
+};
+
+struct AreaLight {
+  ParamSet params;
+  Loc at;
+};
+
+struct ShapeRecord {
+  std::string type;
+  ParamSet params;
+  Mat ctm[2];
+  int material = 0;
+  std::optional<AreaLight> area;
+  Loc at;
+};
+
+struct GraphicsState {
+  Mat ctm[2];
+  unsigned active = 3;  // ActiveTransform: bit 0 StartTime, bit 1 EndTime
+  int material = 0;
+  std::optional<AreaLight> area;
+};
+
+struct StackEntry {
+  GraphicsState state;
+  bool attribute = true;  // AttributeBegin (true) or TransformBegin (false)
+  Loc at;
+};
+
+struct TextureValue {
+  bool isFloat = false;
+  Rgb value{1, 1, 1};
+};
+
+struct Statement {  // an options-block statement kept until WorldBegin
+  std::string type;
+  ParamSet params;
+  Loc at;
+  bool given = false;
+};
+
+class Cursor;
+
+class Importer {
+ public:
+  ImportResult result;
+
+  void parseFile(const std::string& path, int depth, const std::string& where) {
+    std::string text = readWholeFile(path, where);
+    parseText(text, path, depth);
+  }
+  void parseText(const std::string& text, const std::string& file, int depth);
+  void finish(const std::string& file);
+  std::string mainDir;  // pbrt's search directory: the main scene file's
+
+ private:
+  // statements
+  void statement(Cursor& c, const Token& word, int depth);
+  void applyTransform(const Mat& m, bool replace);
+  void worldBegin(const Loc& at);
+  void shape(const std::string& type, ParamSet params, const Loc& at);
+  void lightSource(const std::string& type, const ParamSet& ps, const Loc& at);
+  void texture(const std::string& name, const std::string& kind, const std::string& type, const ParamSet& ps, const Loc& at);
+  MaterialSlot makeMaterial(const std::string& type, const ParamSet& ps, const Loc& at, const std::string& name);
+
+  // mapping
+  void emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& instanceAt);
+  void emitAreaLight(const ShapeRecord& rec, const std::vector<Vec3f>& verts, const std::vector<uint32_t>& idx,
+                     const Mat ctm[2]);
+  struct MotionPlan {
+    bool moving = false;
+    Mat still;  // world' (mirrored) placement when not moving
+    scene::MotionDesc keys;
+  };
+  MotionPlan planMotion(const Mat ctm[2], const Loc& at, const std::string& what) const;
+  uint32_t materialIndex(int slot);
+  std::string uniqueMaterialName(const std::string& base);
+  Rgb color(const ParamSet& ps, const std::string& name, Rgb fallback) const;
+  double floatParam(const ParamSet& ps, const std::string& name, double fallback) const;
+  Rgb lightScale(const ParamSet& ps) const;
+  void note(const Loc& at, const std::string& what);
+  void requireWorld(const Loc& at, const std::string& stmt) const;
+  void requireOptions(const Loc& at, const std::string& stmt) const;
+
+  GraphicsState gs_;
+  std::vector<StackEntry> stack_;
+  std::vector<MaterialSlot> materials_ = {defaultMaterial()};
+  std::map<std::string, int> namedMaterials_;
+  std::map<std::string, TextureValue> textures_;
+  std::map<std::string, Mat> coordSystems_;
+  std::map<std::string, std::vector<ShapeRecord>> instances_;
+  std::vector<ShapeRecord>* currentInstance_ = nullptr;
+  std::string currentInstanceName_;
+  std::set<std::string> materialNames_;
+  std::set<std::string> notedKinds_;
+
+  bool inWorld_ = false, sawWorld_ = false, worldEnded_ = false;
+  float transformStart_ = 0, transformEnd_ = 1;
+  Statement camera_, film_, sampler_, integrator_;
+  Mat cameraCtm_[2];
+  bool mirror_ = true;
+  float shutterOpen_ = 0, shutterClose_ = 1;
+  double imagingRatio_ = 1;  // pbrt-v4 film: exposure time * ISO / 100
+  Loc worldAt_;
+
+  static MaterialSlot defaultMaterial() {
+    MaterialSlot s;  // pbrt's default: diffuse, reflectance 0.5
+    s.desc.type = scene::MaterialDesc::Type::Diffuse;
+    s.desc.albedo.color = Rgb(0.5f);
+    s.desc.name = "default";
+    return s;
+  }
+};
+
+}  // namespace tdpm::pbrt::detail

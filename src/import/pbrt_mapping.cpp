@@ -1,0 +1,579 @@
+// import/pbrt_mapping.cpp — the mapping half of the pbrt import: pbrt
+// materials, textures, lights and shapes (with their CTMs and motion) onto
+// scene::SceneDescription, exactly or as a located error; the documented
+// approximations leave a note. The statement half is pbrt_import.cpp.
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+#include "core/error.h"
+#include "import/pbrt_importer.h"
+#include "import/ply_reader.h"
+#include "import/scene_json_writer.h"
+
+namespace tdpm::pbrt::detail {
+
+// ------------------------------------------------------------ materials / textures
+
+static double roughnessToAlphaV3(double r) {
+  double x = std::log(std::max(r, 1e-3));
+  return 1.62142 + 0.819955 * x + 0.1734 * x * x + 0.0171201 * x * x * x + 0.000640711 * x * x * x * x;
+}
+
+Rgb Importer::color(const ParamSet& ps, const std::string& name, Rgb fallback) const {
+  const Param* p = ps.find(name);
+  if (!p) return fallback;
+  p->used = true;
+  if (p->type == "rgb") {
+    if (p->numbers.size() != 3) ps.fail(*p, "expected 3 numbers");
+    return {float(p->numbers[0]), float(p->numbers[1]), float(p->numbers[2])};
+  }
+  if (p->type == "float") {
+    if (p->numbers.size() != 1) ps.fail(*p, "expected 1 number");
+    return Rgb(float(p->numbers[0]));
+  }
+  if (p->type == "texture") {
+    if (p->strings.size() != 1) ps.fail(*p, "expected one texture name");
+    auto it = textures_.find(p->strings[0]);
+    if (it == textures_.end()) ps.fail(*p, "no texture named \"" + p->strings[0] + "\" has been defined");
+    return it->second.value;
+  }
+  if (p->type == "spectrum" || p->type == "blackbody")
+    ps.fail(*p, "spectral values are not supported; give \"rgb " + name + "\"");
+  ps.fail(*p, "expected rgb, float or texture");
+}
+
+double Importer::floatParam(const ParamSet& ps, const std::string& name, double fallback) const {
+  const Param* p = ps.find(name);
+  if (!p) return fallback;
+  if (p->type == "texture") {
+    p->used = true;
+    auto it = p->strings.size() == 1 ? textures_.find(p->strings[0]) : textures_.end();
+    if (it == textures_.end() || !it->second.isFloat) ps.fail(*p, "expected a float texture");
+    return it->second.value.r;
+  }
+  if (p->type == "spectrum" && p->numbers.size() == 1) {  // v4 allows a constant spectrum for eta
+    p->used = true;
+    return p->numbers[0];
+  }
+  return ps.getFloat(name, fallback);
+}
+
+void Importer::texture(const std::string& name, const std::string& kind, const std::string& type, const ParamSet& ps,
+                       const Loc& at) {
+  bool isFloat = kind == "float";
+  if (!isFloat && kind != "spectrum" && kind != "color" && kind != "rgb")
+    failAt(at, "Texture \"" + name + "\": unknown texture kind \"" + kind + "\" (float or spectrum)");
+  TextureValue t;
+  t.isFloat = isFloat;
+  if (type == "constant") {
+    t.value = isFloat ? Rgb(float(floatParam(ps, "value", 1.0))) : color(ps, "value", Rgb(1.0f));
+  } else if (type == "checkerboard") {
+    failAt(at, "Texture \"" + name + "\": checkerboard is not supported: pbrt's checkerboard is laid out in (u, v), "
+               "tdpm's checker in object-space (x, y, z), and the two do not agree in general");
+  } else {
+    failAt(at, "Texture \"" + name + "\": type \"" + type + "\" is not supported (constant)");
+  }
+  ps.checkAllUsed();
+  textures_[name] = t;
+}
+
+static float reflectanceAtNormal(double eta, double k) {
+  return float(((eta - 1) * (eta - 1) + k * k) / ((eta + 1) * (eta + 1) + k * k));
+}
+
+static void checkReflectance(const ParamSet& ps, const std::string& name, Rgb c) {
+  if (c.r < 0 || c.g < 0 || c.b < 0 || c.maxComponent() > 1) {
+    if (const Param* p = ps.find(name)) ps.fail(*p, "reflectance must be in [0, 1] per channel (energy conservation)");
+    throw Error(ps.file() + ": " + ps.statement() + ": " + name + " must be in [0, 1]");
+  }
+}
+
+MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps, const Loc& at, const std::string& name) {
+  using T = scene::MaterialDesc::Type;
+  MaterialSlot slot;
+  scene::MaterialDesc& m = slot.desc;
+  std::string label = name.empty() ? type : name;
+  auto roughness = [&](bool v3, double fallback, double* alpha) {
+    double u = floatParam(ps, "uroughness", floatParam(ps, "roughness", fallback));
+    double v = floatParam(ps, "vroughness", floatParam(ps, "roughness", fallback));
+    if (u != v) failAt(at, label + ": anisotropic roughness (uroughness != vroughness) is not supported");
+    bool remap = ps.getBool("remaproughness", true);
+    if (u < 0) failAt(at, label + ": roughness must not be negative");
+    *alpha = !remap || u == 0 ? u : (v3 ? roughnessToAlphaV3(u) : std::sqrt(u));
+    if (*alpha > 1) failAt(at, label + ": roughness maps to GGX alpha " + fmtNum(*alpha) + " > 1, which tdpm does not support");
+  };
+  if (type == "" || type == "interface" || type == "none") {
+    slot.interface = true;
+  } else if (type == "matte" || type == "diffuse") {
+    m.type = T::Diffuse;
+    std::string key = type == "matte" ? "Kd" : "reflectance";
+    m.albedo.color = color(ps, key, Rgb(0.5f));
+    checkReflectance(ps, key, m.albedo.color);
+    if (type == "matte" && floatParam(ps, "sigma", 0) != 0) failAt(at, label + ": Oren-Nayar roughness (sigma > 0) is not supported");
+  } else if (type == "mirror") {
+    m.type = T::Mirror;
+    m.specular = color(ps, "Kr", Rgb(0.9f));
+    checkReflectance(ps, "Kr", m.specular);
+  } else if (type == "glass" || type == "dielectric") {
+    m.type = T::Dielectric;
+    double eta = floatParam(ps, "eta", ps.has("index") ? floatParam(ps, "index", 1.5) : 1.5);
+    if (!(eta >= 1)) failAt(at, label + ": eta " + fmtNum(eta) + " below 1 is not supported");
+    m.ior = float(eta);
+    double alpha;
+    roughness(type == "glass", 0, &alpha);
+    if (alpha != 0) failAt(at, label + ": rough glass is not supported (roughness must be 0)");
+    if (type == "glass") {
+      Rgb kr = color(ps, "Kr", Rgb(1.0f)), kt = color(ps, "Kt", Rgb(1.0f));
+      if (kr.r != kt.r || kr.g != kt.g || kr.b != kt.b)
+        failAt(at, label + ": Kr and Kt differ; tdpm's dielectric has one tint for reflection and transmission");
+      checkReflectance(ps, "Kr", kr);
+      m.specular = kr;
+    }
+  } else if (type == "metal" || type == "conductor") {
+    bool v3 = type == "metal";
+    Rgb r0;
+    if (!v3 && ps.has("reflectance")) {
+      r0 = color(ps, "reflectance", Rgb(1.0f));
+    } else {
+      if (!ps.has("eta") || !ps.has("k"))
+        failAt(at, label + ": give \"rgb eta\" and \"rgb k\" (pbrt's default is spectral copper, which tdpm cannot represent)");
+      Rgb eta = color(ps, "eta", Rgb(1.0f)), k = color(ps, "k", Rgb(0.0f));
+      for (int i = 0; i < 3; ++i) r0[i] = reflectanceAtNormal(eta[i], k[i]);
+    }
+    checkReflectance(ps, "reflectance", r0);
+    double alpha;
+    roughness(v3, v3 ? 0.01 : 0.0, &alpha);
+    if (alpha == 0) {
+      m.type = T::Mirror;  // a smooth conductor: its Fresnel curve becomes the constant normal-incidence value
+      m.specular = r0;
+    } else {
+      m.type = T::Metal;
+      m.specular = r0;
+      m.roughness = float(std::max(alpha, 1e-3));
+    }
+    note(at, label + ": conductor approximated by its reflectance at normal incidence (Schlick) with GGX alpha " +
+                 fmtNum(alpha) + " (see docs/pbrt-import.md)");
+  } else if (type == "plastic" || type == "coateddiffuse") {
+    bool v3 = type == "plastic";
+    m.type = T::Plastic;
+    std::string key = v3 ? "Kd" : "reflectance";
+    m.albedo.color = color(ps, key, Rgb(v3 ? 0.25f : 0.5f));
+    checkReflectance(ps, key, m.albedo.color);
+    double alpha;
+    roughness(v3, v3 ? 0.1 : 0.0, &alpha);
+    m.roughness = float(std::max(alpha, 1e-3));
+    if (v3) {
+      color(ps, "Ks", Rgb(0.25f));
+      m.ior = 1.5f;
+    } else {
+      double eta = floatParam(ps, "eta", 1.5);
+      if (!(eta >= 1)) failAt(at, label + ": eta below 1 is not supported");
+      m.ior = float(eta);
+      Rgb albedo = color(ps, "albedo", Rgb(0.0f));
+      if (!albedo.isBlack()) failAt(at, label + ": a coating with a scattering albedo is not supported");
+      for (const char* q : {"thickness", "g", "maxdepth", "nsamples"}) ps.markUsed(q);
+    }
+    note(at, label + ": " + type + " approximated by tdpm's plastic (Lambert base under a GGX dielectric coating, ior " +
+                 fmtNum(m.ior) + (v3 ? "; Ks ignored" : "; thickness ignored") + ")");
+  } else {
+    failAt(at, "material type \"" + type + "\" is not supported (see docs/pbrt-import.md)");
+  }
+  ps.markUsed("type");
+  ps.checkAllUsed();
+  m.name = name;  // unique names are given when a shape first uses the material
+  return slot;
+}
+
+std::string Importer::uniqueMaterialName(const std::string& base) {
+  std::string name = base;
+  for (int i = 2; materialNames_.count(name); ++i) name = base + "#" + std::to_string(i);
+  materialNames_.insert(name);
+  return name;
+}
+
+uint32_t Importer::materialIndex(int slot) {
+  MaterialSlot& s = materials_[size_t(slot)];
+  if (s.index < 0) {
+    scene::MaterialDesc d = s.desc;
+    d.name = uniqueMaterialName(d.name.empty() ? "material" + std::to_string(slot) : d.name);
+    result.scene.materials.push_back(d);
+    s.index = int(result.scene.materials.size()) - 1;
+  }
+  return uint32_t(s.index);
+}
+
+// ------------------------------------------------------------ lights
+
+Rgb Importer::lightScale(const ParamSet& ps) const {
+  const Param* p = ps.find("scale");
+  if (!p) return Rgb(1.0f);
+  return color(ps, "scale", Rgb(1.0f));  // float (v4) or rgb (v3)
+}
+
+static Rgb nonNegative(const ParamSet& ps, const std::string& name, Rgb c) {
+  if (c.r < 0 || c.g < 0 || c.b < 0) {
+    if (const Param* p = ps.find(name)) ps.fail(*p, "must be non-negative in every channel");
+  }
+  return c;
+}
+
+void Importer::lightSource(const std::string& type, const ParamSet& ps, const Loc& at) {
+  if (currentInstance_) failAt(at, "LightSource inside an object definition is not supported");
+  Mat W = mirror_ ? mirrorX() : Mat();
+  Mat M = W * gs_.ctm[0];
+  if (!(gs_.ctm[0] == gs_.ctm[1]))
+    note(at, "LightSource: lights do not move in pbrt; the StartTime transform is used (as pbrt does)");
+  Rgb sc = lightScale(ps);
+  double power = ps.has("power") ? ps.getFloat("power", -1) : -1;
+  scene::LightDesc l;
+  l.name = "LightSource \"" + type + "\" (" + at.str() + ")";
+  if (type == "point") {
+    Rgb I = nonNegative(ps, "I", color(ps, "I", Rgb(1.0f))) * sc;
+    if (power > 0) I = I * float(power / (4 * kPiD));
+    l.type = scene::LightDesc::Type::Point;
+    l.position = M.point(ps.getPoint("from", {0, 0, 0}));
+    l.power = I * float(4 * kPiD);
+  } else if (type == "spot") {
+    Rgb I = nonNegative(ps, "I", color(ps, "I", Rgb(1.0f))) * sc;
+    double cone = ps.getFloat("coneangle", 30), delta = ps.getFloat("conedeltaangle", 5);
+    if (!(cone > 0 && cone <= 90)) failAt(at, "LightSource \"spot\": coneangle must be in (0, 90] degrees for tdpm, got " + fmtNum(cone));
+    if (!(delta >= 0 && delta <= cone)) failAt(at, "LightSource \"spot\": conedeltaangle must be in [0, coneangle], got " + fmtNum(delta));
+    double cosT = std::cos(cone * kPiD / 180), cosS = std::cos((cone - delta) * kPiD / 180);
+    if (power > 0) I = I * float(power / (2 * kPiD * ((1 - cosS) + (cosS - cosT) / 2)));  // pbrt-v4's k_e
+    Vec3f from = ps.getPoint("from", {0, 0, 0}), to = ps.getPoint("to", {0, 0, 1});
+    Vec3f dir = M.vector(to - from);
+    if (!(length(dir) > 0)) failAt(at, "LightSource \"spot\": from and to coincide");
+    std::optional<Pose> p = decompose(M);
+    if (!p || std::fabs(std::fabs(p->scale.x) - std::fabs(p->scale.y)) > 1e-5f * std::fabs(p->scale.x) ||
+        std::fabs(std::fabs(p->scale.x) - std::fabs(p->scale.z)) > 1e-5f * std::fabs(p->scale.x))
+      failAt(at, "LightSource \"spot\": a non-uniform scale or shear would distort the cone; not supported");
+    l.type = scene::LightDesc::Type::Spot;
+    l.position = M.point(from);
+    l.direction = canonicalDirection(normalize(dir));
+    l.coneAngle = float(cone);
+    l.falloffStart = float(cone - delta);
+    float solid = float(2 * kPiD * ((1 - cosS) + (cosS - cosT) / 5));  // tdpm's exact integral of the quartic falloff
+    l.power = I * solid;
+    if (delta > 0)
+      note(at, "LightSource \"spot\": the falloff band uses pbrt-v3's quartic curve; pbrt-v4 uses smoothstep there");
+  } else if (type == "distant") {
+    if (power > 0) failAt(at, "LightSource \"distant\": \"power\" depends on pbrt's scene radius; give L instead");
+    Rgb L = nonNegative(ps, "L", color(ps, "L", Rgb(1.0f))) * sc;
+    Vec3f from = ps.getPoint("from", {0, 0, 0}), to = ps.getPoint("to", {0, 0, 1});
+    Vec3f dir = M.vector(to - from);
+    if (!(length(dir) > 0)) failAt(at, "LightSource \"distant\": from and to coincide");
+    l.type = scene::LightDesc::Type::Directional;
+    l.direction = canonicalDirection(normalize(dir));  // pbrt's light travels from "from" toward "to"
+    l.power = L;                   // irradiance on a surface facing the light
+  } else if (type == "infinite") {
+    if (ps.has("filename") || ps.has("mapname")) failAt(at, "LightSource \"infinite\": an environment map is not supported (constant L only)");
+    if (power > 0 || ps.has("illuminance")) failAt(at, "LightSource \"infinite\": \"power\"/\"illuminance\" is not supported; give L");
+    Rgb L = nonNegative(ps, "L", color(ps, "L", Rgb(1.0f))) * sc;
+    for (const char* q : {"nsamples", "samples"}) ps.markUsed(q);
+    ps.checkAllUsed();
+    result.scene.background = result.scene.background + L;
+    return;
+  } else {
+    failAt(at, "LightSource \"" + type + "\" is not supported (point, spot, distant, infinite)");
+  }
+  ps.checkAllUsed();
+  result.scene.lights.push_back(l);
+}
+
+// ------------------------------------------------------------ shapes
+
+void Importer::shape(const std::string& type, ParamSet params, const Loc& at) {
+  ShapeRecord rec{type, std::move(params), {gs_.ctm[0], gs_.ctm[1]}, gs_.material, gs_.area, at};
+  if (currentInstance_) {
+    if (rec.area) failAt(at, "Shape: area lights inside an object definition are not supported (pbrt ignores them too)");
+    currentInstance_->push_back(std::move(rec));
+    return;
+  }
+  Mat ctm[2] = {gs_.ctm[0], gs_.ctm[1]};
+  emitShape(rec, ctm, {});
+}
+
+namespace {
+struct Geometry {
+  bool sphere = false;
+  float radius = 1;
+  std::vector<Vec3f> vertices;
+  std::vector<uint32_t> indices;
+};
+}  // namespace
+
+static std::vector<Vec3f> readPoints(const ParamSet& ps, const std::string& name) {
+  const Param* p = ps.find(name);
+  if (!p) throw Error(ps.file() + ": " + ps.statement() + ": missing parameter \"point3 " + name + "\"");
+  if (p->type != "point3") ps.fail(*p, "expected type point3");
+  std::vector<double> v = ps.getFloats(name);
+  if (v.empty() || v.size() % 3) ps.fail(*p, "expected a non-empty multiple of 3 numbers, got " + std::to_string(v.size()));
+  std::vector<Vec3f> out;
+  for (size_t i = 0; i < v.size(); i += 3) out.push_back({float(v[i]), float(v[i + 1]), float(v[i + 2])});
+  return out;
+}
+
+static std::vector<uint32_t> readIndices(const ParamSet& ps, size_t vertexCount, size_t per, const std::string& what) {
+  const Param* p = ps.find("indices");
+  std::vector<uint32_t> out;
+  if (!p) {
+    if (vertexCount != per)
+      throw Error(ps.file() + ": " + ps.statement() + ": missing parameter \"integer indices\" (only a single " + what +
+                  " of " + std::to_string(per) + " points may omit it)");
+    for (uint32_t i = 0; i < per; ++i) out.push_back(i);
+    return out;
+  }
+  std::vector<int64_t> v = ps.getInts("indices");
+  if (v.empty() || v.size() % per)
+    ps.fail(*p, "expected a non-empty multiple of " + std::to_string(per) + " indices, got " + std::to_string(v.size()));
+  for (int64_t i : v) {
+    if (i < 0 || uint64_t(i) >= vertexCount)
+      ps.fail(*p, "index " + std::to_string(i) + " is out of range (there are " + std::to_string(vertexCount) + " points)");
+    out.push_back(uint32_t(i));
+  }
+  return out;
+}
+
+// Appends quads (a, b, c, d in the file's corner order) as two triangles:
+// exact only for flat parallelograms, where pbrt-v3's triangle split and
+// pbrt-v4's bilinear patch agree.
+static void addQuads(const std::vector<Vec3f>& P, const std::vector<uint32_t>& quads, const Loc& at, const std::string& what,
+              std::vector<uint32_t>* triangles) {
+  for (size_t i = 0; i < quads.size(); i += 4) {
+    Vec3f a = P[quads[i]], b = P[quads[i + 1]], c = P[quads[i + 2]], d = P[quads[i + 3]];
+    float scale = std::max({length(b - a), length(d - a), 1e-30f});
+    if (length((a + c) - (b + d)) > 1e-5f * scale)
+      failAt(at, what + ": quad " + std::to_string(i / 4) + " is not a flat parallelogram (pbrt-v3 and v4 would render it differently)");
+    triangles->insert(triangles->end(), {quads[i], quads[i + 1], quads[i + 2], quads[i], quads[i + 2], quads[i + 3]});
+  }
+}
+
+static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(const std::string&)>& note, const std::string& mainDir) {
+  const ParamSet& ps = rec.params;
+  Geometry g;
+  if (rec.type == "sphere") {
+    g.sphere = true;
+    double r = ps.getFloat("radius", 1);
+    if (!(r > 0)) failAt(rec.at, "Shape \"sphere\": radius must be positive, got " + fmtNum(r));
+    double zmin = ps.getFloat("zmin", -r), zmax = ps.getFloat("zmax", r), phimax = ps.getFloat("phimax", 360);
+    if (zmin > -r || zmax < r || phimax < 360)
+      failAt(rec.at, "Shape \"sphere\": partial spheres (zmin, zmax, phimax) are not supported");
+    g.radius = float(r);
+  } else if (rec.type == "trianglemesh" || rec.type == "bilinearmesh") {
+    bool bilinear = rec.type == "bilinearmesh";
+    std::vector<Vec3f> P = readPoints(ps, "P");
+    std::vector<uint32_t> idx = readIndices(ps, P.size(), bilinear ? 4 : 3, bilinear ? "patch" : "triangle");
+    for (const char* q : {"N", "uv", "S", "st", "faceIndices"})
+      if (ps.has(q)) {
+        ps.markUsed(q);
+        note(std::string("Shape \"") + rec.type + "\": \"" + q + "\" ignored (tdpm shades with the geometric normal)");
+      }
+    g.vertices = P;
+    if (!bilinear) {
+      g.indices = idx;
+    } else {
+      // A bilinear patch (p00, p10, p01, p11) is flat and equal to two
+      // triangles exactly when it is a parallelogram.
+      for (size_t i = 0; i < idx.size(); i += 4) {
+        Vec3f p00 = P[idx[i]], p10 = P[idx[i + 1]], p01 = P[idx[i + 2]], p11 = P[idx[i + 3]];
+        Vec3f gap = (p00 + p11) - (p10 + p01);
+        float scale = std::max({length(p10 - p00), length(p01 - p00), 1e-30f});
+        if (length(gap) > 1e-5f * scale)
+          failAt(rec.at, "Shape \"bilinearmesh\": patch " + std::to_string(i / 4) +
+                             " is not a flat parallelogram; only those are exactly two triangles");
+        g.indices.insert(g.indices.end(), {idx[i], idx[i + 1], idx[i + 3], idx[i], idx[i + 3], idx[i + 2]});
+      }
+    }
+  } else if (rec.type == "plymesh") {
+    std::string file = ps.getString("filename", "");
+    if (file.empty()) failAt(rec.at, "Shape \"plymesh\": missing parameter \"string filename\"");
+    if (ps.has("displacement")) failAt(rec.at, "Shape \"plymesh\": displacement is not supported");
+    ps.markUsed("edgelength");
+    PlyMesh ply;
+    try {
+      ply = readPly(resolvePath(file, rec.at.file, mainDir));
+    } catch (const Error& e) {
+      failAt(rec.at, std::string("Shape \"plymesh\": ") + e.what());
+    }
+    for (const std::string& q : ply.ignoredProperties)
+      note("Shape \"plymesh\": vertex property \"" + q + "\" ignored (tdpm shades with the geometric normal)");
+    g.vertices = std::move(ply.vertices);
+    g.indices = std::move(ply.triangles);
+    addQuads(g.vertices, ply.quads, rec.at, "Shape \"plymesh\" \"" + file + "\"", &g.indices);
+  } else {
+    failAt(rec.at, "Shape \"" + rec.type + "\" is not supported (sphere, trianglemesh, bilinearmesh, plymesh)");
+  }
+  ps.checkAllUsed();
+  return g;
+}
+
+Importer::MotionPlan Importer::planMotion(const Mat ctm[2], const Loc& at, const std::string& what) const {
+  MotionPlan plan;
+  Mat W = mirror_ ? mirrorX() : Mat();
+  if (ctm[0] == ctm[1]) {
+    plan.still = W * ctm[0];
+    return plan;
+  }
+  // pbrt splits each transform into T R S and interpolates T and S
+  // linearly and R by slerp between TransformTimes; tdpm's keyframes do the
+  // same, so the two poses become two keyframes (clipped to the shutter).
+  std::optional<Pose> p[2];
+  for (int i = 0; i < 2; ++i) {
+    p[i] = decompose(ctm[i]);
+    if (!p[i] || ctm[i].det3() < 0)
+      failAt(at, what + ": its " + (i ? "EndTime" : "StartTime") +
+                     " transform has shear, a scale along rotated axes or a mirror; pbrt would interpolate its polar "
+                     "decomposition, which tdpm's keyframes cannot express");
+  }
+  float t0 = transformStart_, t1 = transformEnd_;
+  auto poseAt = [&](float t) {
+    float u = std::clamp((t - t0) / (t1 - t0), 0.0f, 1.0f);
+    Pose q;
+    q.translate = lerp(p[0]->translate, p[1]->translate, u);
+    q.rotate = slerp(p[0]->rotate, p[1]->rotate, u);
+    q.scale = lerp(p[0]->scale, p[1]->scale, u);
+    return q;
+  };
+  auto toMat = [](const Pose& q) {
+    Affine3f a = Affine3f::fromTRS(q.translate, q.rotate, q.scale);
+    Mat m;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 4; ++j) m.m[i][j] = a.m[i][j];
+    return m;
+  };
+  float a = std::max(t0, shutterOpen_), b = std::min(t1, shutterClose_);
+  if (!(a < b)) {
+    // The shutter sees one pose: before the start, after the end, or an instant.
+    if (t1 <= shutterOpen_) plan.still = W * ctm[1];
+    else if (t0 >= shutterClose_) plan.still = W * ctm[0];
+    else plan.still = W * toMat(poseAt(a));
+    return plan;
+  }
+  plan.moving = true;
+  for (float t : {a, b}) {
+    Pose q = poseAt(t);
+    if (mirror_) q = mirrorPose(q);
+    scene::TransformDesc d;
+    d.translate = q.translate;
+    d.rotate = canonicalRotation(q.rotate);
+    d.scale = q.scale;
+    plan.keys.times.push_back(t);
+    plan.keys.poses.push_back(d);
+  }
+  return plan;
+}
+
+static bool nearlyUniform(Vec3f s) {
+  float a = std::fabs(s.x);
+  return std::fabs(std::fabs(s.y) - a) <= 1e-5f * a && std::fabs(std::fabs(s.z) - a) <= 1e-5f * a;
+}
+
+void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& instanceAt) {
+  Geometry g = makeGeometry(rec, [&](const std::string& w) { note(rec.at, w); }, mainDir);
+  const MaterialSlot& mat = materials_[size_t(rec.material)];
+  if (rec.area) {
+    if (g.sphere) failAt(rec.at, "Shape \"sphere\" with an AreaLightSource: tdpm's area lights are rectangles");
+    emitAreaLight(rec, g.vertices, g.indices, ctm);
+    return;
+  }
+  if (mat.interface) return;  // no surface: invisible without participating media
+  scene::ObjectDesc o;
+  o.name = "Shape \"" + rec.type + "\" (" + rec.at.str() + (instanceAt.file.empty() ? "" : ", instance at " + instanceAt.str()) + ")";
+  MotionPlan plan = planMotion(ctm, rec.at, "Shape \"" + rec.type + "\"");
+  if (g.sphere) {
+    o.shape.type = scene::ShapeDesc::Type::Sphere;
+    o.shape.radius = g.radius;
+    if (!plan.moving) {
+      std::optional<Pose> p = decompose(plan.still);
+      if (!p || !nearlyUniform(p->scale))
+        failAt(rec.at, "Shape \"sphere\" under a non-uniform scale or shear (an ellipsoid) is not supported");
+      o.placement.translate = p->translate;
+      o.placement.rotate = canonicalRotation(p->rotate);
+      o.placement.scale = p->scale;
+    } else {
+      for (const auto& k : plan.keys.poses)
+        if (!nearlyUniform(k.scale)) failAt(rec.at, "Shape \"sphere\" under a non-uniform scale (an ellipsoid) is not supported");
+      o.motion = plan.keys;
+    }
+  } else {
+    o.shape.type = scene::ShapeDesc::Type::Mesh;
+    o.shape.indices = g.indices;
+    if (!plan.moving) {
+      // Bake the placement into the vertices (any affine map is exact). A
+      // mirroring map flips the winding; swap it back so the face normal
+      // keeps pbrt's orientation (which transforms normals, not windings).
+      for (Vec3f v : g.vertices) o.shape.vertices.push_back(plan.still.point(v));
+      if (plan.still.det3() < 0)
+        for (size_t i = 0; i < o.shape.indices.size(); i += 3) std::swap(o.shape.indices[i + 1], o.shape.indices[i + 2]);
+    } else {
+      o.shape.vertices = g.vertices;
+      o.motion = plan.keys;
+    }
+    for (Vec3f v : o.shape.vertices)
+      if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+        failAt(rec.at, "Shape \"" + rec.type + "\": a vertex is not finite after its transform");
+  }
+  o.material = materialIndex(rec.material);
+  result.scene.objects.push_back(std::move(o));
+}
+
+void Importer::emitAreaLight(const ShapeRecord& rec, const std::vector<Vec3f>& verts, const std::vector<uint32_t>& idx,
+                             const Mat ctm[2]) {
+  const ParamSet& ps = rec.area->params;
+  const std::string what = "AreaLightSource (" + rec.area->at.str() + ") on Shape \"" + rec.type + "\"";
+  bool twoSided = ps.getBool("twosided", false);
+  if (twoSided) failAt(rec.area->at, "AreaLightSource: twosided emitters are not supported (tdpm's area lights emit from one side)");
+  MotionPlan plan = planMotion(ctm, rec.at, what);
+  if (plan.moving) failAt(rec.at, what + ": a moving area light is not supported");
+  const Mat& M = plan.still;
+  // tdpm's area light is one rectangle: the shape must be two triangles
+  // covering a rectangle, both facing the same way.
+  std::vector<uint32_t> corners(idx.begin(), idx.end());
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  if (idx.size() != 6 || corners.size() != 4)
+    failAt(rec.at, what + ": tdpm's area lights are rectangles; the shape must be one rectangle (2 triangles, 4 points)");
+  Vec3f P[4];
+  for (int i = 0; i < 4; ++i) P[i] = M.point(verts[corners[size_t(i)]]);
+  int far = 1;
+  for (int i = 2; i < 4; ++i)
+    if (length(P[i] - P[0]) > length(P[far] - P[0])) far = i;
+  int a = far == 1 ? 2 : 1, b = far == 3 ? 2 : 3;
+  Vec3f e1 = P[a] - P[0], e2 = P[b] - P[0];
+  float l1 = length(e1), l2 = length(e2);
+  Vec3f tri[2];
+  float triArea = 0;
+  for (int t = 0; t < 2; ++t) {
+    Vec3f p0 = verts[idx[size_t(3 * t)]], p1 = verts[idx[size_t(3 * t + 1)]], p2 = verts[idx[size_t(3 * t + 2)]];
+    tri[t] = M.normal(cross(p1 - p0, p2 - p0));  // pbrt's normal: the object-space one, transformed as a normal
+    triArea += 0.5f * length(cross(M.point(p1) - M.point(p0), M.point(p2) - M.point(p0)));
+  }
+  float rectArea = l1 * l2;
+  bool rectangle = l1 > 0 && l2 > 0 && std::fabs(dot(e1, e2)) <= 1e-4f * l1 * l2 &&
+                   length(P[0] + e1 + e2 - P[far]) <= 1e-4f * (l1 + l2) && std::fabs(triArea - rectArea) <= 1e-4f * rectArea &&
+                   dot(tri[0], tri[1]) > 0;
+  if (!rectangle) failAt(rec.at, what + ": the shape is not a rectangle of two triangles facing the same way");
+  Vec3f n = normalize(tri[0]);
+  Vec3f x = e1 / l1, y = -n, z = cross(x, y);
+  double R[3][3] = {{x.x, y.x, z.x}, {x.y, y.y, z.y}, {x.z, y.z, z.z}};
+  Rgb L = nonNegative(ps, "L", color(ps, "L", Rgb(1.0f))) * lightScale(ps);
+  double power = ps.has("power") ? ps.getFloat("power", -1) : -1;
+  if (power > 0) L = L * float(power / (kPiD * rectArea));  // pbrt-v4: one side, area A
+  if (ps.has("filename")) failAt(rec.area->at, "AreaLightSource: an image emitter (filename) is not supported");
+  ps.checkAllUsed();
+  scene::LightDesc l;
+  l.type = scene::LightDesc::Type::Area;
+  l.name = what;
+  l.areaSize = {l1, l2};
+  l.placement.translate = P[0] + (e1 + e2) * 0.5f;
+  l.placement.rotate = canonicalRotation(quaternionFromMatrix(R));
+  l.power = L * float(kPiD * rectArea);  // Lambertian: power = L pi A
+  const MaterialSlot& mat = materials_[size_t(rec.material)];
+  bool black = mat.interface || (mat.desc.type == scene::MaterialDesc::Type::Diffuse && mat.desc.albedo.color.isBlack());
+  if (!black)
+    note(rec.at, what + ": tdpm's area lights do not reflect light; the emitter's material is ignored");
+  result.scene.lights.push_back(l);
+}
+
+}  // namespace tdpm::pbrt::detail

@@ -1,0 +1,274 @@
+// import/scene_json_writer.cpp — writing a SceneDescription as JSON + OBJ.
+#include "import/scene_json_writer.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+
+namespace tdpm::pbrt {
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+// Exactly as scene/parse.cpp reads a rotation (safeNormalize, then
+// fromAxisAngle with degrees * (pi / 180) in float).
+Vec3f parserNormalize(Vec3f v) {
+  float m = std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)});
+  return normalize(v / m);
+}
+
+// The shortest decimal that reads back as the same float (so the JSON shows
+// 0.2, not 0.20000000298023224).
+double num(float f) {
+  char buf[32];
+  for (int digits = 6; digits < 9; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, double(f));
+    double d = std::strtod(buf, nullptr);
+    if (float(d) == f) return d;
+  }
+  std::snprintf(buf, sizeof buf, "%.9g", double(f));
+  return std::strtod(buf, nullptr);
+}
+
+Json vec(Vec3f v) { return Json::array({num(v.x), num(v.y), num(v.z)}); }
+Json rgb(Rgb c) { return Json::array({num(c.r), num(c.g), num(c.b)}); }
+
+bool isIdentity(const Quaternion& q) { return q.w == 1 && q.x == 0 && q.y == 0 && q.z == 0; }
+
+Json rotation(const Quaternion& q) {
+  Vec3f axis;
+  float deg;
+  axisAngleOf(q, &axis, &deg);
+  return Json{{"axis", vec(axis)}, {"angle", num(deg)}};
+}
+
+Json transform(const scene::TransformDesc& t) {
+  Json j = Json::object();
+  if (t.translate.x != 0 || t.translate.y != 0 || t.translate.z != 0) j["translate"] = vec(t.translate);
+  if (!isIdentity(t.rotate)) j["rotate"] = rotation(t.rotate);
+  if (t.scale.x != 1 || t.scale.y != 1 || t.scale.z != 1) j["scale"] = vec(t.scale);
+  return j;
+}
+
+Json motion(const scene::MotionDesc& m) {
+  Json a = Json::array();
+  for (size_t i = 0; i < m.times.size(); ++i) {
+    Json k = transform(m.poses[i]);
+    Json key = Json{{"time", num(m.times[i])}};
+    for (auto& [name, value] : k.items()) key[name] = value;
+    a.push_back(key);
+  }
+  return a;
+}
+
+Json texture(const scene::TextureDesc& t) {
+  if (t.kind == scene::TextureDesc::Kind::Constant) return Json{{"type", "constant"}, {"color", rgb(t.color)}};
+  return Json{{"type", "checker"}, {"colors", Json::array({rgb(t.color), rgb(t.color2)})}, {"scale", num(t.scale)}};
+}
+
+Json material(const scene::MaterialDesc& m) {
+  using T = scene::MaterialDesc::Type;
+  Json j;
+  auto albedo = [&]() {
+    if (m.albedo.kind == scene::TextureDesc::Kind::Constant) j["color"] = rgb(m.albedo.color);
+    else j["texture"] = texture(m.albedo);
+  };
+  switch (m.type) {
+    case T::Diffuse: j["type"] = "diffuse"; albedo(); break;
+    case T::Mirror: j["type"] = "mirror"; j["color"] = rgb(m.specular); break;
+    case T::Dielectric: j["type"] = "dielectric"; j["ior"] = num(m.ior); j["tint"] = rgb(m.specular); break;
+    case T::Metal: j["type"] = "metal"; j["color"] = rgb(m.specular); j["roughness"] = num(m.roughness); break;
+    case T::Plastic:
+      j["type"] = "plastic";
+      albedo();
+      j["ior"] = num(m.ior);
+      j["roughness"] = num(m.roughness);
+      break;
+  }
+  return j;
+}
+
+// Shortest text that reads back as the same float (OBJ readers parse to
+// double, then round to float: 9 significant digits are enough).
+std::string objNumber(float v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", double(v));
+  return buf;
+}
+
+std::string objText(const scene::ShapeDesc& s) {
+  std::string out = "# written by tdpm convert\n";
+  for (Vec3f v : s.vertices) out += "v " + objNumber(v.x) + " " + objNumber(v.y) + " " + objNumber(v.z) + "\n";
+  for (size_t i = 0; i + 2 < s.indices.size(); i += 3)
+    out += "f " + std::to_string(s.indices[i] + 1) + " " + std::to_string(s.indices[i + 1] + 1) + " " +
+           std::to_string(s.indices[i + 2] + 1) + "\n";
+  return out;
+}
+
+const char* lightType(scene::LightDesc::Type t) {
+  switch (t) {
+    case scene::LightDesc::Type::Point: return "point";
+    case scene::LightDesc::Type::Spot: return "spot";
+    case scene::LightDesc::Type::Directional: return "directional";
+    case scene::LightDesc::Type::Area: return "area";
+  }
+  return "point";
+}
+
+}  // namespace
+
+Quaternion rotationAsParsed(Vec3f axis, float degrees) {
+  constexpr float kDegrees = kPi / 180.0f;
+  return Quaternion::fromAxisAngle(parserNormalize(axis), degrees * kDegrees);
+}
+
+void axisAngleOf(const Quaternion& q, Vec3f* axis, float* degrees) {
+  // No sign normalisation (w < 0 gives an angle above 180 degrees): q and
+  // -q are the same rotation, but only q itself reads back bit for bit.
+  double s = std::sqrt(double(q.x) * q.x + double(q.y) * q.y + double(q.z) * q.z);
+  if (s == 0) {
+    *axis = {0, 1, 0};
+    *degrees = 0;
+    return;
+  }
+  *axis = {float(q.x / s), float(q.y / s), float(q.z / s)};
+  *degrees = float(2.0 * std::atan2(s, double(q.w)) * 180.0 / 3.14159265358979323846);
+}
+
+Quaternion canonicalRotation(const Quaternion& q) {
+  Quaternion c = q;
+  for (int i = 0; i < 4; ++i) {
+    Vec3f axis;
+    float deg;
+    axisAngleOf(c, &axis, &deg);
+    if (deg == 0) return Quaternion{};
+    Quaternion next = rotationAsParsed(axis, deg);
+    if (next.w == c.w && next.x == c.x && next.y == c.y && next.z == c.z) return c;
+    c = next;
+  }
+  return c;
+}
+
+Vec3f canonicalDirection(Vec3f d) {
+  for (int i = 0; i < 4; ++i) {
+    Vec3f n = parserNormalize(d);
+    if (n.x == d.x && n.y == d.y && n.z == d.z) return d;
+    d = n;
+  }
+  return d;
+}
+
+SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& jsonPath) {
+  SceneJson out;
+  std::filesystem::path jp(jsonPath);
+  std::string stem = jp.stem().string();
+  Json root;
+  const scene::CameraDesc& c = sc.camera;
+  Json cam{{"position", vec(c.position)}, {"target", vec(c.target)}, {"up", vec(c.up)}, {"fov", num(c.fovDegrees)},
+           {"resolution", Json::array({c.width, c.height})},
+           {"shutter", Json::array({num(c.shutterOpen), num(c.shutterClose)})}};
+  if (!c.motion.empty()) {
+    Json m = Json::array();
+    for (const auto& k : c.motion)
+      m.push_back(Json{{"time", num(k.time)}, {"position", vec(k.position)}, {"target", vec(k.target)}, {"up", vec(k.up)}});
+    cam["motion"] = m;
+  }
+  root["camera"] = cam;
+  Json materials = Json::object();
+  for (const auto& m : sc.materials) {
+    if (materials.contains(m.name)) throw Error(jsonPath + ": two materials are named \"" + m.name + "\"");
+    materials[m.name] = material(m);
+  }
+  root["materials"] = materials;
+  Json objects = Json::array();
+  for (const auto& o : sc.objects) {
+    Json j{{"name", o.name}};
+    const scene::ShapeDesc& s = o.shape;
+    switch (s.type) {
+      case scene::ShapeDesc::Type::Sphere: j["shape"] = Json{{"type", "sphere"}, {"radius", num(s.radius)}}; break;
+      case scene::ShapeDesc::Type::Quad:
+        j["shape"] = Json{{"type", "quad"}, {"size", Json::array({num(s.size.x), num(s.size.z)})}};
+        break;
+      case scene::ShapeDesc::Type::Box: j["shape"] = Json{{"type", "box"}, {"size", vec(s.size)}}; break;
+      case scene::ShapeDesc::Type::Mesh: {
+        std::string name = stem + ".mesh" + std::to_string(out.meshFiles.size()) + ".obj";
+        out.meshFiles.push_back({(jp.parent_path() / name).string(), objText(s)});
+        j["shape"] = Json{{"type", "mesh"}, {"file", name}};
+        break;
+      }
+    }
+    j["material"] = sc.materials.at(o.material).name;
+    Json t = transform(o.placement);
+    if (!t.empty()) j["transform"] = t;
+    if (!o.motion.empty()) j["motion"] = motion(o.motion);
+    objects.push_back(j);
+  }
+  root["objects"] = objects;
+  Json lights = Json::array();
+  for (const auto& l : sc.lights) {
+    Json j{{"type", lightType(l.type)}, {"name", l.name}};
+    switch (l.type) {
+      case scene::LightDesc::Type::Point: j["position"] = vec(l.position); j["power"] = rgb(l.power); break;
+      case scene::LightDesc::Type::Spot:
+        j["position"] = vec(l.position);
+        j["direction"] = vec(l.direction);
+        j["cone_angle"] = num(l.coneAngle);
+        j["falloff_start"] = num(l.falloffStart);
+        j["power"] = rgb(l.power);
+        break;
+      case scene::LightDesc::Type::Directional:
+        j["direction"] = vec(l.direction);
+        j["irradiance"] = rgb(l.power);
+        break;
+      case scene::LightDesc::Type::Area:
+        j["size"] = Json::array({num(l.areaSize.x), num(l.areaSize.y)});
+        j["power"] = rgb(l.power);
+        break;
+    }
+    Json t = transform(l.placement);
+    if (!t.empty()) j["transform"] = t;
+    if (!l.motion.empty()) j["motion"] = motion(l.motion);
+    lights.push_back(j);
+  }
+  root["lights"] = lights;
+  root["background"] = rgb(sc.background);
+  const scene::RenderSettings& r = sc.render;
+  Json render = Json::object();
+  if (r.method) render["method"] = *r.method;
+  if (r.spp) render["spp"] = *r.spp;
+  if (r.maxSpp) render["max_spp"] = *r.maxSpp;
+  if (r.contrast) render["contrast"] = num(*r.contrast);
+  if (r.seed) render["seed"] = *r.seed;
+  if (r.maxDepth) render["max_depth"] = *r.maxDepth;
+  if (r.exposure) render["exposure"] = num(*r.exposure);
+  if (r.photons) render["photons"] = *r.photons;
+  if (r.globalPhotons) render["global_photons"] = *r.globalPhotons;
+  if (r.frames) render["frames"] = *r.frames;
+  if (r.search) render["search"] = *r.search;
+  if (r.k) render["k"] = *r.k;
+  if (r.fraction) render["fraction"] = num(*r.fraction);
+  if (r.kappa) render["kappa"] = num(*r.kappa);
+  if (r.maxRadius) render["max_radius"] = num(*r.maxRadius);
+  if (r.maxDt) render["max_dt"] = num(*r.maxDt);
+  if (r.kernelSpace) render["kernel_space"] = *r.kernelSpace;
+  if (r.kernelTime) render["kernel_time"] = *r.kernelTime;
+  if (r.gather) render["gather"] = *r.gather;
+  root["render"] = render;
+  out.json = root.dump(2) + "\n";
+  return out;
+}
+
+void writeSceneJson(const scene::SceneDescription& scene, const std::string& jsonPath) {
+  SceneJson s = sceneToJson(scene, jsonPath);
+  for (const auto& [path, text] : s.meshFiles) writeTextFileAtomic(path, text);
+  writeTextFileAtomic(jsonPath, s.json);
+}
+
+}  // namespace tdpm::pbrt
