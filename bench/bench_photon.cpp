@@ -218,6 +218,22 @@ void BM_SelectSimd(benchmark::State& state) {
 }
 BENCHMARK(BM_SelectSimd);
 
+// The xsimd (AVX2) kernel by name, whatever the dispatch picked: on an
+// AVX-512 CPU the run then has both kinds' selection ratios.
+void BM_SelectXsimd(benchmark::State& state) {
+  SelectData& d = selectData();
+  const int stride = SelectData::kS + photon::kSelectPadding, keep = SelectData::kS / 2;
+  size_t s = 0;
+  for (auto _ : state) {
+    size_t j = s++ & (SelectData::kSets - 1);
+    photon::TimeWindow w = photon::selectTimeWindowXsimd(d.bins.data() + j * size_t(stride), SelectData::kS, d.u[j],
+                                                         keep, std::numeric_limits<float>::infinity());
+    benchmark::DoNotOptimize(w);
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()));
+}
+BENCHMARK(BM_SelectXsimd);
+
 void BM_SelectQuickselect(benchmark::State& state) {
   SelectData& d = selectData();
   const int stride = SelectData::kS + photon::kSelectPadding, keep = SelectData::kS / 2;

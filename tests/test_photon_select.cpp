@@ -7,9 +7,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "core/rng.h"
+#include "math/simd.h"
 #include "photon/temporal_select.h"
 
 using namespace tdpm;
@@ -106,6 +108,48 @@ TEST_CASE("temporal selection: SIMD and quickselect keep exactly the nth_element
   }
   MESSAGE(cases << " selections compared");
   CHECK(mismatches == 0);
+}
+
+// Runtime dispatch (math/simd.h): the AVX-512 kernel must return exactly the
+// windows of the xsimd (AVX2) one, so images and bench ratios do not depend
+// on the CPU. On a CPU without AVX-512 the xsimd kernel is still checked
+// against quickselect and the comparison is skipped (said in a message).
+TEST_CASE("temporal selection: the AVX-512 and xsimd kernels return identical windows") {
+  const bool has512 = simd::cpuHasAvx512();
+  if (!has512) MESSAGE("this CPU has no AVX-512 (F+BW): only the xsimd kernel is checked");
+  Rng rng(77);
+  std::vector<float> scratch(20000);
+  const Shape shapes[] = {Shape::Random, Shape::Correlated, Shape::TwoValues, Shape::Extremes, Shape::AllEqual};
+  int cases = 0, mismatches = 0;
+  for (int rep = 0; rep < 3000; ++rep) {
+    // Mostly k_s-sized inputs; some long ones cross the xsimd byte-counter
+    // chunk (255 batches) and every tail length modulo 64.
+    int n = rep % 10 == 0 ? 1 + int(rng.below(20000)) : 1 + int(rng.below(300));
+    std::vector<uint8_t> bins = makeBins(shapes[rng.below(5)], n, rng);
+    for (int i = 0; i < kSelectPadding; ++i) bins[size_t(n + i)] = uint8_t(rng.below(256));  // junk padding
+    float u = randomQuery(rng, rep);
+    int keep = keptCount(rng.uniform(), n);
+    float maxDist = rng.below(3) == 0 ? 0.5f + 40.0f * rng.uniform() : std::numeric_limits<float>::infinity();
+    TimeWindow x = selectTimeWindowXsimd(bins.data(), n, u, keep, maxDist);
+    TimeWindow q = selectTimeWindowQuickselect(bins.data(), n, u, keep, maxDist, scratch.data(), rng);
+    bool ok = x.lo == q.lo && x.hi == q.hi && x.kept == q.kept;
+    if (has512) {
+      TimeWindow a = selectTimeWindowAvx512(bins.data(), n, u, keep, maxDist);
+      ok &= a.lo == x.lo && a.hi == x.hi && a.kept == x.kept;
+      if (!ok && mismatches < 5)
+        MESSAGE("n=" << n << " u=" << u << " keep=" << keep << " avx512=[" << a.lo << "," << a.hi << "]#" << a.kept
+                     << " xsimd=[" << x.lo << "," << x.hi << "]#" << x.kept);
+    }
+    ++cases;
+    mismatches += !ok;
+  }
+  MESSAGE(cases << " selections compared, kernel in use: " << std::string(simd::kernelName(simd::activeKernel())));
+  CHECK(mismatches == 0);
+  // The dispatching entry point runs one of the two.
+  std::vector<uint8_t> bins(20 + kSelectPadding, 7);
+  TimeWindow w = selectTimeWindow(bins.data(), 20, 7.5f, 5, std::numeric_limits<float>::infinity());
+  CHECK(w.lo == 7);
+  CHECK(w.kept == 20);
 }
 
 TEST_CASE("temporal selection: ties at the cut are kept whole; window never splits a bin") {

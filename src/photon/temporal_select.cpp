@@ -1,4 +1,5 @@
-// photon/temporal_select.cpp — SIMD and quickselect temporal selection.
+// photon/temporal_select.cpp — SIMD (xsimd, and AVX-512 dispatched at run
+// time) and quickselect temporal selection.
 #include "photon/temporal_select.h"
 
 #include <algorithm>
@@ -6,6 +7,10 @@
 #include <type_traits>
 
 #include "math/simd.h"
+
+#if TDPM_HAVE_AVX512_KERNELS
+#include <immintrin.h>
+#endif
 
 namespace tdpm::photon {
 
@@ -118,17 +123,16 @@ inline void intervalAfter(int s, int qt, float beta, int& lo, int& hi) {
   hi = std::min(255, qt + R);
 }
 
-}  // namespace
-
-TimeWindow selectTimeWindow(const uint8_t* bins, int n, float u, int keep, float maxDistBins) {
+// The search shared by both kernels; count(lo, hi) is the number of
+// candidates with lo <= bin <= hi.
+template <class Count>
+inline TimeWindow searchWindow(int n, float u, int keep, float maxDistBins, const Count& count) {
   TimeWindow w;
   if (n <= 0 || keep <= 0) return w;
   keep = std::min(keep, n);
   u = std::clamp(u, 0.0f, 256.0f);
   const int qt = std::min(int(u), 255);
   const float beta = u - float(qt);
-  const int fullBatches = n / kLanes;
-  const B tailMask = maskBytes(B::load_aligned(kIota.v) < B(uint8_t(n - fullBatches * kLanes)));
 
   // Binary search for the first step whose interval holds >= keep
   // candidates; 513 steps always cover [0, 255] from any start.
@@ -138,7 +142,7 @@ TimeWindow selectTimeWindow(const uint8_t* bins, int n, float u, int keep, float
     int mid = (sLo + sHi) / 2;
     int l, h;
     intervalAfter(mid, qt, beta, l, h);
-    int c = countInRange(bins, n, l, h, tailMask, fullBatches);
+    int c = count(l, h);
     if (c >= keep) {
       sHi = mid;
       lo = l;
@@ -156,13 +160,71 @@ TimeWindow selectTimeWindow(const uint8_t* bins, int n, float u, int keep, float
     if (lim.lo > lo || lim.hi < hi) {
       lo = std::max(lo, lim.lo);
       hi = std::min(hi, lim.hi);
-      cnt = countInRange(bins, n, lo, hi, tailMask, fullBatches);
+      cnt = count(lo, hi);
     }
   }
   w.lo = lo;
   w.hi = hi;
   w.kept = cnt;
   return w;
+}
+
+#if TDPM_HAVE_AVX512_KERNELS
+// AVX-512 BW: 64 candidates per compare, straight into a mask register, and
+// a popcount instead of byte counters. Only ever called where
+// simd::cpuHasAvx512() (the target attribute keeps the rest of the build
+// free of AVX-512). The padding (kSelectPadding = 64) makes the last load
+// readable; the tail lanes are masked off.
+struct Count512 {
+  const uint8_t* bins;
+  int n;
+  __attribute__((target("avx512f,avx512bw,popcnt"))) int operator()(int lo, int hi) const {
+    const __m512i vlo = _mm512_set1_epi8(char(lo)), vw = _mm512_set1_epi8(char(hi - lo));
+    const int full = n / 64;
+    int total = 0;
+    for (int b = 0; b < full; ++b) {
+      __m512i d = _mm512_sub_epi8(_mm512_loadu_si512(bins + b * 64), vlo);
+      total += int(__builtin_popcountll(_mm512_cmple_epu8_mask(d, vw)));  // (bin - lo) mod 256 <= hi - lo
+    }
+    const int rest = n - full * 64;
+    if (rest > 0) {
+      __m512i d = _mm512_sub_epi8(_mm512_loadu_si512(bins + full * 64), vlo);
+      unsigned long long m = _mm512_cmple_epu8_mask(d, vw) & ((1ull << rest) - 1ull);
+      total += int(__builtin_popcountll(m));
+    }
+    return total;
+  }
+};
+#endif
+
+}  // namespace
+
+TimeWindow selectTimeWindowXsimd(const uint8_t* bins, int n, float u, int keep, float maxDistBins) {
+  if (n <= 0 || keep <= 0) return TimeWindow{};
+  const int fullBatches = n / kLanes;
+  const B tailMask = maskBytes(B::load_aligned(kIota.v) < B(uint8_t(n - fullBatches * kLanes)));
+  return searchWindow(n, u, keep, maxDistBins, [&](int lo, int hi) {
+    return countInRange(bins, n, lo, hi, tailMask, fullBatches);
+  });
+}
+
+#if TDPM_HAVE_AVX512_KERNELS
+// flatten: the search and Count512 inline into this AVX-512 function (a
+// default-target function may not inline an AVX-512 one).
+__attribute__((target("avx512f,avx512bw,popcnt"), flatten)) TimeWindow selectTimeWindowAvx512(
+    const uint8_t* bins, int n, float u, int keep, float maxDistBins) {
+  return searchWindow(n, u, keep, maxDistBins, Count512{bins, n});
+}
+#else
+TimeWindow selectTimeWindowAvx512(const uint8_t* bins, int n, float u, int keep, float maxDistBins) {
+  return selectTimeWindowXsimd(bins, n, u, keep, maxDistBins);
+}
+#endif
+
+TimeWindow selectTimeWindow(const uint8_t* bins, int n, float u, int keep, float maxDistBins) {
+  static const bool use512 = simd::activeKernel() == simd::Kernel::Avx512;
+  return use512 ? selectTimeWindowAvx512(bins, n, u, keep, maxDistBins)
+                : selectTimeWindowXsimd(bins, n, u, keep, maxDistBins);
 }
 
 namespace {

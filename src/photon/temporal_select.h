@@ -18,7 +18,8 @@
 //  window that holds exactly the kept photons.
 //
 // Two implementations that return identical results:
-//  * selectTimeWindow: SIMD (xsimd through math/simd.h). The bins in order of
+//  * selectTimeWindow: SIMD (xsimd through math/simd.h, or AVX-512 BW with
+//    one mask compare + popcount per 64 candidates, chosen at run time). The bins in order of
 //    distance from u form a merge of the two sides (with exact ties merged
 //    into one step), so the interval after s steps is closed-form, and the
 //    number of candidates inside an interval is a byte range test + count
@@ -59,8 +60,16 @@ inline float timeKey(int q, float u) {
 // contents) up to n rounded up to a multiple of kSelectPadding.
 // u: query time in bin units, in [0, 256]. maxDistBins: the maximum time
 // distance |c_q - u| in bins (infinity for none).
+// Dispatches to the AVX-512 kernel where the CPU has it (math/simd.h:
+// simd::activeKernel(), TDPM_SIMD=avx2 forces the xsimd one); both return
+// identical windows.
 constexpr int kSelectPadding = 64;
 TimeWindow selectTimeWindow(const uint8_t* bins, int n, float u, int keep, float maxDistBins);
+// The two kernels by name (tests and benchmarks). The AVX-512 one may only be
+// called where simd::cpuHasAvx512(); without AVX-512 kernels in the build it
+// is the xsimd one.
+TimeWindow selectTimeWindowXsimd(const uint8_t* bins, int n, float u, int keep, float maxDistBins);
+TimeWindow selectTimeWindowAvx512(const uint8_t* bins, int n, float u, int keep, float maxDistBins);
 
 // Scalar reference; scratch must hold n floats.
 TimeWindow selectTimeWindowQuickselect(const uint8_t* bins, int n, float u, int keep, float maxDistBins,
