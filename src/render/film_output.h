@@ -3,7 +3,6 @@
 // variance of each pixel's mean) and its PNG preview, committed as a pair.
 // Metadata is the caller's.
 #pragma once
-#include <cstdint>
 #include <string>
 
 #include "image/exr.h"
@@ -23,10 +22,6 @@ image::ExrFile filmToExr(Film&& film);
 // they were and no temporary remains. Throws tdpm::Error naming the file.
 void writeRenderOutputs(const std::string& exrPath, const std::string& pngPath, const image::ExrFile& exr,
                         float exposureStops);
-
-// Bytes per pixel the write path holds at its peak beyond the moved film:
-// the three split variance layers while the interleaved variance still
-// exists (12), then the 8-bit preview (3). See render/memory_budget.h.
-constexpr uint64_t kOutputExtraBytesPerPixel = 12;
+// Its peak memory per pixel is render/memory_budget.h kWriteBytesPerPixel.
 
 }  // namespace tdpm
