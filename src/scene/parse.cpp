@@ -35,7 +35,7 @@ using detail::joinNames;
 using detail::Node;
 using detail::Source;
 
-constexpr int64_t kMaxResolution = 65536;
+using limits::kMaxResolution;
 constexpr float kDegrees = kPi / 180.0f;
 
 struct Shutter {
