@@ -18,10 +18,10 @@
 #include "image/exr.h"
 #include "image/png.h"
 #include "import/pbrt_import.h"
+#include "photon/store.h"
 #include "render/film_output.h"
 #include "render/renderer.h"
 #include "render/threads.h"
-#include "photon/store.h"
 #include "scene/limits.h"
 #include "scene/parse.h"
 #include "scene/scene.h"
@@ -94,8 +94,9 @@ void parseResolution(const std::string& text, int& w, int& h) {
   std::istringstream in(text);
   if (!(in >> a >> x >> b) || (x != 'x' && x != 'X') || (in >> extra))
     throw Error("--resolution: expected WxH (for example 640x480), got '" + text + "'");
-  if (a < 1 || b < 1 || a > 65536 || b > 65536)
-    throw Error("--resolution: width and height must be between 1 and 65536, got '" + text + "'");
+  if (a < 1 || b < 1 || a > limits::kMaxResolution || b > limits::kMaxResolution)
+    throw Error("--resolution: width and height must be between 1 and " + std::to_string(limits::kMaxResolution) +
+                ", got '" + text + "'");
   w = a;
   h = b;
 }

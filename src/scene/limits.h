@@ -46,6 +46,7 @@ constexpr float kMaxScale = 1e12f;
 constexpr float kMinKeyframeGap = 1e-6f;
 
 // ---- render settings: the flag and the scene key share one range
+constexpr int kMaxResolution = 65536;  // pixels per side: camera.resolution and --resolution
 struct IntRange {
   int64_t lo, hi;
 };

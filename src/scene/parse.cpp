@@ -35,7 +35,7 @@ using detail::joinNames;
 using detail::Node;
 using detail::Source;
 
-constexpr int64_t kMaxResolution = 65536;
+using limits::kMaxResolution;
 constexpr float kDegrees = kPi / 180.0f;
 
 struct Shutter {
@@ -683,7 +683,10 @@ RenderSettings readRender(const Node& n, float shutterLength) {
   if (n.has("k")) r.k = readCount(n.member("k"), "k", limits::kK);
   if (n.has("fraction")) r.fraction = readFloatInRange(n.member("fraction"), "fraction", limits::kFraction);
   if (n.has("kappa")) r.kappa = readKappa(n.member("kappa"), shutterLength);
-  if (n.has("max_radius")) r.maxRadius = readFloatInRange(n.member("max_radius"), "max_radius", limits::kMaxRadius);
+  if (n.has("max_radius")) {
+    readPositive(n.member("max_radius"), "max_radius");  // the plain message for <= 0
+    r.maxRadius = readFloatInRange(n.member("max_radius"), "max_radius", limits::kMaxRadius);
+  }
   if (n.has("max_dt")) r.maxDt = readPositive(n.member("max_dt"), "max_dt");
   if (n.has("kernel_space")) r.kernelSpace = n.member("kernel_space").choice(kSpaceKernels, "space kernel");
   if (n.has("kernel_time")) r.kernelTime = n.member("kernel_time").choice(kTimeKernels, "time kernel");
