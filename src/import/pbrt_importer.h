@@ -34,10 +34,19 @@ std::string readWholeFile(const std::string& path, const std::string& where);
 // one is used, so scenes written for pbrt's rule load too.
 std::string resolvePath(const std::string& name, const std::string& namingFile, const std::string& mainDir);
 
+// A 2D checkerboard in (u, v): parity of floor(uscale u + udelta) +
+// floor(vscale v + vdelta) picks tex1 (even) or tex2 (odd).
+struct Checker2D {
+  Rgb tex1{1, 1, 1}, tex2{0, 0, 0};
+  double su = 1, sv = 1, du = 0, dv = 0;
+  std::string name;
+};
+
 struct MaterialSlot {
   bool interface = false;  // "" / "interface" / "none": no surface at all
   scene::MaterialDesc desc;
   int index = -1;  // in scene.materials once a shape uses it
+  std::optional<Checker2D> checker;  // albedo: laid out per shape (pbrt_mapping.cpp, placeChecker)
 };
 
 struct AreaLight {
@@ -70,6 +79,7 @@ struct StackEntry {
 struct TextureValue {
   bool isFloat = false;
   Rgb value{1, 1, 1};
+  std::optional<Checker2D> checker;
 };
 
 struct Statement {  // an options-block statement kept until WorldBegin
@@ -113,6 +123,7 @@ class Importer {
     scene::MotionDesc keys;
   };
   MotionPlan planMotion(const Mat ctm[2], const Loc& at, const std::string& what) const;
+  std::optional<Checker2D> albedoChecker(const ParamSet& ps, const std::string& name) const;
   uint32_t materialIndex(int slot);
   std::string uniqueMaterialName(const std::string& base);
   Rgb color(const ParamSet& ps, const std::string& name, Rgb fallback) const;

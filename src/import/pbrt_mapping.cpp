@@ -36,6 +36,7 @@ Rgb Importer::color(const ParamSet& ps, const std::string& name, Rgb fallback) c
     if (p->strings.size() != 1) ps.fail(*p, "expected one texture name");
     auto it = textures_.find(p->strings[0]);
     if (it == textures_.end()) ps.fail(*p, "no texture named \"" + p->strings[0] + "\" has been defined");
+    if (it->second.checker) ps.fail(*p, "a checkerboard is supported only as the reflectance of diffuse or plastic materials");
     return it->second.value;
   }
   if (p->type == "spectrum" || p->type == "blackbody")
@@ -69,13 +70,40 @@ void Importer::texture(const std::string& name, const std::string& kind, const s
   if (type == "constant") {
     t.value = isFloat ? Rgb(float(floatParam(ps, "value", 1.0))) : color(ps, "value", Rgb(1.0f));
   } else if (type == "checkerboard") {
-    failAt(at, "Texture \"" + name + "\": checkerboard is not supported: pbrt's checkerboard is laid out in (u, v), "
-               "tdpm's checker in object-space (x, y, z), and the two do not agree in general");
+    if (isFloat) failAt(at, "Texture \"" + name + "\": a float checkerboard is not supported (only as a reflectance)");
+    if (ps.getInt("dimension", 2) != 2) failAt(at, "Texture \"" + name + "\": a 3D checkerboard is not supported (dimension 2 only)");
+    if (ps.getString("mapping", "uv") != "uv") failAt(at, "Texture \"" + name + "\": only the \"uv\" mapping is supported");
+    Checker2D c;
+    c.name = name;
+    c.tex1 = color(ps, "tex1", Rgb(1.0f));
+    c.tex2 = color(ps, "tex2", Rgb(0.0f));
+    c.su = ps.getFloat("uscale", 1);
+    c.sv = ps.getFloat("vscale", 1);
+    c.du = ps.getFloat("udelta", 0);
+    c.dv = ps.getFloat("vdelta", 0);
+    if (!(c.su > 0) || !(c.sv > 0)) failAt(at, "Texture \"" + name + "\": uscale and vscale must be positive");
+    for (const char* q : {"aamode", "filter"})
+      if (ps.has(q)) ps.markUsed(q);
+    note(at, "Texture \"" + name + "\": the checkerboard's antialiasing filter is not applied (tdpm supersamples instead)");
+    t.checker = c;
   } else {
     failAt(at, "Texture \"" + name + "\": type \"" + type + "\" is not supported (constant)");
   }
   ps.checkAllUsed();
   textures_[name] = t;
+}
+
+std::optional<Checker2D> Importer::albedoChecker(const ParamSet& ps, const std::string& name) const {
+  const Param* p = ps.find(name);
+  if (!p || p->type != "texture" || p->strings.size() != 1) return std::nullopt;
+  auto it = textures_.find(p->strings[0]);
+  if (it == textures_.end() || !it->second.checker) return std::nullopt;
+  p->used = true;
+  const Checker2D& c = *it->second.checker;
+  for (Rgb v : {c.tex1, c.tex2})
+    if (v.r < 0 || v.g < 0 || v.b < 0 || v.maxComponent() > 1)
+      ps.fail(*p, "the checkerboard's colours must be reflectances in [0, 1] per channel");
+  return c;
 }
 
 static float reflectanceAtNormal(double eta, double k) {
@@ -108,7 +136,8 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
   } else if (type == "matte" || type == "diffuse") {
     m.type = T::Diffuse;
     std::string key = type == "matte" ? "Kd" : "reflectance";
-    m.albedo.color = color(ps, key, Rgb(0.5f));
+    slot.checker = albedoChecker(ps, key);
+    m.albedo.color = slot.checker ? slot.checker->tex1 : color(ps, key, Rgb(0.5f));
     checkReflectance(ps, key, m.albedo.color);
     if (type == "matte" && floatParam(ps, "sigma", 0) != 0) failAt(at, label + ": Oren-Nayar roughness (sigma > 0) is not supported");
   } else if (type == "mirror") {
@@ -158,7 +187,8 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     bool v3 = type == "plastic";
     m.type = T::Plastic;
     std::string key = v3 ? "Kd" : "reflectance";
-    m.albedo.color = color(ps, key, Rgb(v3 ? 0.25f : 0.5f));
+    slot.checker = albedoChecker(ps, key);
+    m.albedo.color = slot.checker ? slot.checker->tex1 : color(ps, key, Rgb(v3 ? 0.25f : 0.5f));
     checkReflectance(ps, key, m.albedo.color);
     double alpha;
     roughness(v3, v3 ? 0.1 : 0.0, &alpha);
@@ -300,6 +330,7 @@ struct Geometry {
   float radius = 1;
   std::vector<Vec3f> vertices;
   std::vector<uint32_t> indices;
+  std::vector<Vec2f> uv;  // per vertex, when the file gives them (or a single bilinear patch's defaults)
 };
 }  // namespace
 
@@ -364,7 +395,16 @@ static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(co
     bool bilinear = rec.type == "bilinearmesh";
     std::vector<Vec3f> P = readPoints(ps, "P");
     std::vector<uint32_t> idx = readIndices(ps, P.size(), bilinear ? 4 : 3, bilinear ? "patch" : "triangle");
-    for (const char* q : {"N", "uv", "S", "st", "faceIndices"})
+    std::vector<double> uv = ps.getFloats(ps.has("uv") ? "uv" : "st");
+    if (!uv.empty()) {
+      if (uv.size() != 2 * P.size()) ps.fail(*ps.find(ps.has("uv") ? "uv" : "st"), "expected 2 numbers per point");
+      for (size_t i = 0; i < P.size(); ++i) g.uv.push_back({float(uv[2 * i]), float(uv[2 * i + 1])});
+    } else if (bilinear && P.size() == 4 && idx.size() == 4) {
+      const Vec2f corner[4] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};  // pbrt's default (u, v) of p00, p10, p01, p11
+      g.uv.assign(4, Vec2f{});
+      for (size_t k = 0; k < 4; ++k) g.uv[idx[k]] = corner[k];
+    }
+    for (const char* q : {"N", "S", "faceIndices"})
       if (ps.has(q)) {
         ps.markUsed(q);
         note(std::string("Shape \"") + rec.type + "\": \"" + q + "\" ignored (tdpm shades with the geometric normal)");
@@ -469,6 +509,60 @@ static bool nearlyUniform(Vec3f s) {
   return std::fabs(std::fabs(s.y) - a) <= 1e-5f * a && std::fabs(std::fabs(s.z) - a) <= 1e-5f * a;
 }
 
+// tdpm's checker is 3D in object space: parity of floor(x/s + 1/2) +
+// floor(y/s + 1/2) + floor(z/s + 1/2). On a flat mesh whose (u, v) are an
+// affine, orthogonal parametrisation with square cells it equals pbrt's 2D
+// checkerboard exactly, if the mesh is expressed in a local frame with x
+// along dp/du, z along dp/dv, y = 0 on the surface and
+//   x = s (uscale u + udelta - 1/2),  z = s (vscale v + vdelta - 1/2).
+// Returns the local vertices, the placement and the cell size s.
+struct CheckerFrame {
+  std::vector<Vec3f> local;
+  scene::TransformDesc placement;
+  float cell = 1;
+};
+
+static CheckerFrame placeChecker(const std::vector<Vec3f>& world, const std::vector<Vec2f>& uv,
+                                 const std::vector<uint32_t>& idx, const Checker2D& c, const Loc& at) {
+  const std::string what = "Shape with checkerboard \"" + c.name + "\"";
+  // dp/du, dp/dv from the first triangle with a non-degenerate (u, v).
+  Vec3f dpdu, dpdv;
+  bool found = false;
+  for (size_t t = 0; t + 2 < idx.size() && !found; t += 3) {
+    Vec2f a = uv[idx[t]], b = uv[idx[t + 1]], d = uv[idx[t + 2]];
+    double du1 = b.x - a.x, dv1 = b.y - a.y, du2 = d.x - a.x, dv2 = d.y - a.y;
+    double det = du1 * dv2 - du2 * dv1;
+    if (std::fabs(det) < 1e-12) continue;
+    Vec3f e1 = world[idx[t + 1]] - world[idx[t]], e2 = world[idx[t + 2]] - world[idx[t]];
+    dpdu = (e1 * float(dv2) - e2 * float(dv1)) / float(det);
+    dpdv = (e2 * float(du1) - e1 * float(du2)) / float(det);
+    found = true;
+  }
+  if (!found) failAt(at, what + ": its (u, v) coordinates are degenerate");
+  float lu = length(dpdu), lv = length(dpdv);
+  if (!(lu > 0) || !(lv > 0) || std::fabs(dot(dpdu, dpdv)) > 1e-4f * lu * lv)
+    failAt(at, what + ": (u, v) must run along perpendicular directions for tdpm's checker");
+  float cell = float(lu / c.su);
+  if (std::fabs(float(lv / c.sv) - cell) > 1e-4f * cell)
+    failAt(at, what + ": the cells are not square (tdpm's checker has one cell size)");
+  Vec3f ex = dpdu / lu, ez = dpdv / lv, ey = cross(ez, ex);
+  double R[3][3] = {{ex.x, ey.x, ez.x}, {ex.y, ey.y, ez.y}, {ex.z, ey.z, ez.z}};
+  CheckerFrame f;
+  f.cell = cell;
+  f.placement.rotate = canonicalRotation(quaternionFromMatrix(R));
+  Affine3f rot = Affine3f::rotate(f.placement.rotate);
+  for (size_t i = 0; i < world.size(); ++i)
+    f.local.push_back({float(cell * (c.su * uv[i].x + c.du - 0.5)), 0.0f, float(cell * (c.sv * uv[i].y + c.dv - 0.5))});
+  f.placement.translate = world[idx[0]] - rot.point(f.local[idx[0]]);
+  // Every vertex must be where the affine (u, v) map puts it: a flat mesh.
+  float size = 0;
+  for (Vec3f w : world) size = std::max(size, length(w - world[idx[0]]));
+  for (size_t i = 0; i < world.size(); ++i)
+    if (length(rot.point(f.local[i]) + f.placement.translate - world[i]) > 1e-4f * std::max(size, 1e-30f))
+      failAt(at, what + ": the mesh is not flat with an affine (u, v), which tdpm's checker needs");
+  return f;
+}
+
 void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& instanceAt) {
   Geometry g = makeGeometry(rec, [&](const std::string& w) { note(rec.at, w); }, mainDir);
   const MaterialSlot& mat = materials_[size_t(rec.material)];
@@ -482,6 +576,7 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
   o.name = "Shape \"" + rec.type + "\" (" + rec.at.str() + (instanceAt.file.empty() ? "" : ", instance at " + instanceAt.str()) + ")";
   MotionPlan plan = planMotion(ctm, rec.at, "Shape \"" + rec.type + "\"");
   if (g.sphere) {
+    if (mat.checker) failAt(rec.at, "Shape \"sphere\": a checkerboard on a sphere is not supported (tdpm's checker is not in (u, v))");
     o.shape.type = scene::ShapeDesc::Type::Sphere;
     o.shape.radius = g.radius;
     if (!plan.moving) {
@@ -499,6 +594,27 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
   } else {
     o.shape.type = scene::ShapeDesc::Type::Mesh;
     o.shape.indices = g.indices;
+    if (mat.checker) {
+      if (plan.moving) failAt(rec.at, "a moving shape with a checkerboard is not supported");
+      if (g.uv.empty()) failAt(rec.at, "a checkerboard needs per-vertex \"uv\" (or a single bilinear patch)");
+      std::vector<Vec3f> world;
+      for (Vec3f v : g.vertices) world.push_back(plan.still.point(v));
+      CheckerFrame f = placeChecker(world, g.uv, g.indices, *mat.checker, rec.at);
+      o.shape.vertices = f.local;  // a rigid map of the baked vertices: the winding keeps its orientation
+      o.placement = f.placement;
+      if (plan.still.det3() < 0)
+        for (size_t i = 0; i < o.shape.indices.size(); i += 3) std::swap(o.shape.indices[i + 1], o.shape.indices[i + 2]);
+      scene::MaterialDesc m = mat.desc;  // the cell size depends on the shape: one material per shape
+      m.albedo.kind = scene::TextureDesc::Kind::Checker;
+      m.albedo.color = mat.checker->tex1;
+      m.albedo.color2 = mat.checker->tex2;
+      m.albedo.scale = f.cell;
+      m.name = uniqueMaterialName((mat.desc.name.empty() ? "material" : mat.desc.name) + " (checkerboard " + rec.at.str() + ")");
+      result.scene.materials.push_back(m);
+      o.material = uint32_t(result.scene.materials.size() - 1);
+      result.scene.objects.push_back(std::move(o));
+      return;
+    }
     if (!plan.moving) {
       // Bake the placement into the vertices (any affine map is exact). A
       // mirroring map flips the winding; swap it back so the face normal
