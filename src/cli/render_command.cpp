@@ -299,7 +299,7 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
       ->check(rangeOf(limits::kFraction))->group(photonGroup);
   c->add_option("--kappa", a.kappa, "4d: weight of time in the metric d^2 = |dx|^2 + kappa dt^2 (default 1; for a 1 s shutter at least 7.7e-34 and at most 8.5e37, see docs/scene-format.md)")
       ->check(CLI::PositiveNumber)->group(photonGroup);
-  c->add_option("--max-radius", a.maxRadius, "Largest search radius, scene units (default 2% of the scene's diagonal)")
+  c->add_option("--max-radius", a.maxRadius, "Largest search radius, scene units (default 2% of the scene's diagonal, the diagonal clipped to 20x the camera's distance to its target)")
       ->check(rangeOf(limits::kMaxRadius))->group(photonGroup);
   c->add_option("--max-dt", a.maxDt, "twopass: largest time distance kept, seconds (default: none)")
       ->check(CLI::PositiveNumber)->group(photonGroup);
