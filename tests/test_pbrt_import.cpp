@@ -24,7 +24,7 @@
 #include "import/pbrt_tokenizer.h"
 #include "import/ply_reader.h"
 #include "cli_harness.h"
-#include "import/scene_json_writer.h"
+#include "scene/json_writer.h"
 #include "render/renderer.h"
 #include "scene/material.h"
 #include "scene/parse.h"

@@ -5,7 +5,7 @@
 
 #include "core/error.h"
 #include "import/pbrt_import.h"
-#include "import/scene_json_writer.h"
+#include "scene/json_writer.h"
 
 namespace tdpm::cli {
 

@@ -9,7 +9,7 @@
 #include "core/error.h"
 #include "import/pbrt_importer.h"
 #include "import/ply_reader.h"
-#include "import/scene_json_writer.h"
+#include "scene/json_writer.h"
 
 namespace tdpm::pbrt::detail {
 

@@ -1,4 +1,4 @@
-// import/scene_json_writer.h — SceneDescription -> tdpm's JSON scene format
+// scene/json_writer.h — SceneDescription -> tdpm's JSON scene format, the parser's inverse
 // (docs/scene-format.md), for `tdpm convert`. Meshes go to OBJ files beside
 // the JSON. Parsing the written JSON gives the same description: numbers are
 // written so they read back to the same floats, and rotations and

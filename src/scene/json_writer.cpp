@@ -1,5 +1,5 @@
-// import/scene_json_writer.cpp — writing a SceneDescription as JSON + OBJ.
-#include "import/scene_json_writer.h"
+// scene/json_writer.cpp — writing a SceneDescription as JSON + OBJ.
+#include "scene/json_writer.h"
 
 #include <cmath>
 #include <cstdio>
