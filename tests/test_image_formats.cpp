@@ -479,6 +479,8 @@ TEST_CASE("cli compare: any two formats; NaN/Inf refused unless --allow-nonfinit
   REQUIRE(r.exitCode == 0);
   nlohmann::json j = nlohmann::json::parse(r.output);
   CHECK(j["rmse"]["overall"].get<double>() == 0.0);
+  CHECK(j["test_format"] == "PFM");
+  CHECK(j["reference_format"] == "OpenEXR");
   // HDR against the exact image: only RGBE's quantisation, under 2^-8 of
   // the brightest channel per value.
   r = test::runTdpm("compare" + q("a.hdr") + q("a.pfm") + " --json");

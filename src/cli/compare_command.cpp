@@ -98,10 +98,12 @@ nlohmann::ordered_json channelsJson(const ImageMetrics& m, double image::Channel
   return {{"r", m.channel[0].*field}, {"g", m.channel[1].*field}, {"b", m.channel[2].*field}, {"overall", m.overall.*field}};
 }
 
-void printText(const CompareArgs& a, const image::ImageRgb& test, const ImageMetrics& m,
-               const std::optional<image::RowProfile>& profile) {
-  std::printf("test:      %s (%s)\n", a.test.c_str(), sizeText(test).c_str());
-  std::printf("reference: %s (%s)\n", a.reference.c_str(), sizeText(test).c_str());
+void printText(const CompareArgs& a, const image::LoadedImage& testFile, const image::LoadedImage& refFile,
+               const ImageMetrics& m, const std::optional<image::RowProfile>& profile) {
+  const image::ImageRgb& test = testFile.color;
+  std::printf("test:      %s (%s, %s)\n", a.test.c_str(), sizeText(test).c_str(), image::formatName(testFile.format));
+  std::printf("reference: %s (%s, %s)\n", a.reference.c_str(), sizeText(test).c_str(),
+              image::formatName(refFile.format));
   if (m.nonFiniteTest || m.nonFiniteRef)
     std::printf("non-finite: %zu values in test, %zu in reference (measured as 0, --allow-nonfinite)\n",
                 m.nonFiniteTest, m.nonFiniteRef);
@@ -139,13 +141,16 @@ void printText(const CompareArgs& a, const image::ImageRgb& test, const ImageMet
   }
 }
 
-void printJson(const CompareArgs& a, const image::ImageRgb& test, const ImageMetrics& m,
-               const std::optional<image::RowProfile>& profile) {
+void printJson(const CompareArgs& a, const image::LoadedImage& testFile, const image::LoadedImage& refFile,
+               const ImageMetrics& m, const std::optional<image::RowProfile>& profile) {
   using json = nlohmann::ordered_json;
   using CM = image::ChannelMetrics;
+  const image::ImageRgb& test = testFile.color;
   json j;
   j["test"] = a.test;
   j["reference"] = a.reference;
+  j["test_format"] = image::formatName(testFile.format);
+  j["reference_format"] = image::formatName(refFile.format);
   j["width"] = test.width;
   j["height"] = test.height;
   j["region"] = {{"x", m.region.x}, {"y", m.region.y}, {"w", m.region.w}, {"h", m.region.h}, {"cropped", bool(a.crop)}};
@@ -292,8 +297,8 @@ int runCompare(const CompareArgs& a) {
   if (m.nonFiniteTest || m.nonFiniteRef)
     std::fprintf(stderr, "tdpm: warning: %zu non-finite values in %s and %zu in %s were counted as 0\n",
                  m.nonFiniteTest, a.test.c_str(), m.nonFiniteRef, a.reference.c_str());
-  if (a.json) printJson(a, test.color, m, profile);
-  else printText(a, test.color, m, profile);
+  if (a.json) printJson(a, test, ref, m, profile);
+  else printText(a, test, ref, m, profile);
   return 0;
 }
 
