@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Bounded libFuzzer runs of the scene loader and the EXR reader (fuzz/):
-# configures and builds build-fuzz with clang++ (TDPM_FUZZ=ON, ASan +
-# UBSan), then runs each target on a fresh copy of its seed corpus. Fails
+# Bounded libFuzzer runs of the scene loader, the EXR reader and compare's
+# image dispatcher (fuzz/): builds build-fuzz with clang++ (TDPM_FUZZ=ON,
+# ASan + UBSan), then runs each target on a fresh copy of its seeds. Fails
 # (exit 1) on any crash, sanitizer report, leak, timeout or out-of-memory;
 # the reproducer is left in build-fuzz/findings/<target>/.
 #
@@ -13,8 +13,8 @@
 #
 # Seeds: scenes/*.json, tests/data/*.json and fuzz/corpus/scene/ for fuzz_scene; fuzz/corpus/exr/
 # (small EXRs written by tdpm or oiiotool, plus every input a run ever
-# failed on, named regress-*) for fuzz_exr. The corpus copies grown by a
-# run are thrown away: the seeds in git stay small and reviewed.
+# failed on, named regress-*) for fuzz_exr; fuzz/corpus/pbrt/ for fuzz_pbrt; fuzz/corpus/{pfm,hdr,png}/ for
+# fuzz_image. Grown corpus copies are thrown away: the seeds stay reviewed.
 set -euo pipefail
 
 seconds=25
@@ -42,18 +42,19 @@ jobs=$(nproc 2>/dev/null || echo 2)
 start=$(date +%s)
 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ -DTDPM_FUZZ=ON \
   -DTDPM_BUILD_TESTS=OFF -DTDPM_BUILD_BENCH=OFF >/dev/null
-cmake --build build-fuzz -j "$jobs" --target fuzz_scene fuzz_exr fuzz_pbrt
+cmake --build build-fuzz -j "$jobs" --target fuzz_scene fuzz_exr fuzz_pbrt fuzz_image
 echo "fuzz.sh: build took $(( $(date +%s) - start )) s"
 
 work=build-fuzz/run
 rm -rf "$work"
-mkdir -p "$work/scene" "$work/exr"
+mkdir -p "$work/scene" "$work/exr" "$work/image"
 cp scenes/*.json tests/data/*.json fuzz/corpus/scene/*.json "$work/scene/" 2>/dev/null || true
 cp fuzz/corpus/exr/*.exr "$work/exr/"
 mkdir -p "$work/pbrt" && cp fuzz/corpus/pbrt/*.pbrt "$work/pbrt/"  # seeds of fuzz_pbrt (pbrt import)
+cp fuzz/corpus/pfm/* fuzz/corpus/hdr/* fuzz/corpus/png/* "$work/image/"
 
 status=0
-for target in scene exr pbrt; do
+for target in scene exr pbrt image; do
   findings=build-fuzz/findings/$target
   mkdir -p "$findings"
   log=build-fuzz/fuzz_$target.log

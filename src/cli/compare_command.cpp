@@ -11,11 +11,12 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
+#include <tuple>
 #include <utility>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
-#include "image/exr.h"
+#include "image/read_image.h"
 #include "image/metrics.h"
 #include "image/profile_plot.h"
 
@@ -97,10 +98,15 @@ nlohmann::ordered_json channelsJson(const ImageMetrics& m, double image::Channel
   return {{"r", m.channel[0].*field}, {"g", m.channel[1].*field}, {"b", m.channel[2].*field}, {"overall", m.overall.*field}};
 }
 
-void printText(const CompareArgs& a, const image::ImageRgb& test, const ImageMetrics& m,
-               const std::optional<image::RowProfile>& profile) {
-  std::printf("test:      %s (%s)\n", a.test.c_str(), sizeText(test).c_str());
-  std::printf("reference: %s (%s)\n", a.reference.c_str(), sizeText(test).c_str());
+void printText(const CompareArgs& a, const image::LoadedImage& testFile, const image::LoadedImage& refFile,
+               const ImageMetrics& m, const std::optional<image::RowProfile>& profile) {
+  const image::ImageRgb& test = testFile.color;
+  std::printf("test:      %s (%s, %s)\n", a.test.c_str(), sizeText(test).c_str(), image::formatName(testFile.format));
+  std::printf("reference: %s (%s, %s)\n", a.reference.c_str(), sizeText(test).c_str(),
+              image::formatName(refFile.format));
+  if (m.nonFiniteTest || m.nonFiniteRef)
+    std::printf("non-finite: %zu values in test, %zu in reference (measured as 0, --allow-nonfinite)\n",
+                m.nonFiniteTest, m.nonFiniteRef);
   if (a.crop)
     std::printf("region:    crop %d,%d,%d,%d (%s), %zu pixels\n", m.region.x, m.region.y, m.region.w, m.region.h,
                 rectText(m.region).c_str(), m.pixelCount);
@@ -135,13 +141,16 @@ void printText(const CompareArgs& a, const image::ImageRgb& test, const ImageMet
   }
 }
 
-void printJson(const CompareArgs& a, const image::ImageRgb& test, const ImageMetrics& m,
-               const std::optional<image::RowProfile>& profile) {
+void printJson(const CompareArgs& a, const image::LoadedImage& testFile, const image::LoadedImage& refFile,
+               const ImageMetrics& m, const std::optional<image::RowProfile>& profile) {
   using json = nlohmann::ordered_json;
   using CM = image::ChannelMetrics;
+  const image::ImageRgb& test = testFile.color;
   json j;
   j["test"] = a.test;
   j["reference"] = a.reference;
+  j["test_format"] = image::formatName(testFile.format);
+  j["reference_format"] = image::formatName(refFile.format);
   j["width"] = test.width;
   j["height"] = test.height;
   j["region"] = {{"x", m.region.x}, {"y", m.region.y}, {"w", m.region.w}, {"h", m.region.h}, {"cropped", bool(a.crop)}};
@@ -179,9 +188,13 @@ CLI::App* addCompareCommand(CLI::App& app, CompareArgs& a) {
       "compare",
       "Error of a test image against a reference (RMSE, relative MSE as pbrt-v4's MRSE, MAE, max error, means; "
       "per channel and overall), and line profiles through one row");
-  c->add_option("test", a.test, "Test image (OpenEXR)")->required();
-  c->add_option("reference", a.reference, "Reference image (OpenEXR), same size")->required();
+  c->add_option("test", a.test, "Test image: OpenEXR, PFM, Radiance HDR or PNG (8-bit sRGB decoded to linear)")
+      ->required();
+  c->add_option("reference", a.reference, "Reference image, same size, in any of those formats")->required();
   c->add_flag("--json", a.json, "Print the metrics as one JSON object instead of a table");
+  c->add_flag("--allow-nonfinite", a.allowNonFinite,
+              "Measure images with NaN or infinite values (counted as 0 and reported per image) instead of "
+              "refusing them");
   c->add_option("--crop", a.crop, "Measure only the rectangle x,y,w,h (pixels; 0,0 is the top left)")
       ->check(CLI::Validator(
           [](std::string& s) {
@@ -211,15 +224,15 @@ int runCompare(const CompareArgs& a) {
     checkWritable(flag, *out);
   }
 
-  // readExr's errors already name the file ("<path>: ..."); say which role.
-  image::ExrFile test, ref;
+  // The readers' errors already name the file ("<path>: ..."); say which role.
+  image::LoadedImage test, ref;
   try {
-    test = image::readExr(a.test);
+    test = image::readImage(a.test);
   } catch (const Error& e) {
     throw Error(std::string("test image: ") + e.what());
   }
   try {
-    ref = image::readExr(a.reference);
+    ref = image::readImage(a.reference);
   } catch (const Error& e) {
     throw Error(std::string("reference image: ") + e.what());
   }
@@ -254,6 +267,20 @@ int runCompare(const CompareArgs& a) {
                    : image::extractRowProfile(test.color, ref.color, y, 0, test.color.width);
   }
 
+  // NaN or Inf would count as 0: an Inf where the reference is 0 would
+  // score no error. Refused unless asked for, before any output.
+  const PixelRect region = crop.value_or(PixelRect{0, 0, test.color.width, test.color.height});
+  if (!a.allowNonFinite)
+    for (const auto& [role, path, im] : {std::tuple{"test image", &a.test, &test.color},
+                                         std::tuple{"reference image", &a.reference, &ref.color}}) {
+      image::NonFiniteValues bad = image::findNonFinite(*im, region);
+      if (bad.count)
+        throw Error(std::string(role) + ": " + *path + ": " + std::to_string(bad.count) +
+                    " NaN or infinite values" + (a.crop ? " inside --crop" : "") + ", the first at pixel (" +
+                    std::to_string(bad.x) + ", " + std::to_string(bad.y) + ") channel " + "RGB"[bad.channel] +
+                    "; --allow-nonfinite measures them as 0 and reports their counts");
+    }
+
   ImageMetrics m = image::compareImages(test.color, ref.color, crop);
 
   // Both profile files or neither (each is atomic on its own).
@@ -270,8 +297,8 @@ int runCompare(const CompareArgs& a) {
   if (m.nonFiniteTest || m.nonFiniteRef)
     std::fprintf(stderr, "tdpm: warning: %zu non-finite values in %s and %zu in %s were counted as 0\n",
                  m.nonFiniteTest, a.test.c_str(), m.nonFiniteRef, a.reference.c_str());
-  if (a.json) printJson(a, test.color, m, profile);
-  else printText(a, test.color, m, profile);
+  if (a.json) printJson(a, test, ref, m, profile);
+  else printText(a, test, ref, m, profile);
   return 0;
 }
 

@@ -1,9 +1,11 @@
-// cli/compare_command.h — `tdpm compare TEST.exr REF.exr`: error metrics of a
-// test image against a reference (text or JSON), optionally over a crop, and
-// a line profile through one row as CSV and as an SVG plot.
-// Exit codes: 0 measured; 1 bad input (missing or non-EXR file, sizes that
-// differ, crop or row outside the images, unwritable output); 2 usage
-// (malformed --crop, --csv/--plot without --profile-row).
+// cli/compare_command.h — `tdpm compare TEST REF`: error metrics of a test
+// image against a reference (text or JSON), optionally over a crop, and a
+// line profile through one row as CSV and as an SVG plot. Either image may
+// be OpenEXR, PFM, Radiance HDR or PNG (image/read_image.h).
+// Exit codes: 0 measured; 1 bad input (missing or unreadable file, sizes
+// that differ, NaN/Inf values without --allow-nonfinite, crop or row
+// outside the images, unwritable output); 2 usage (malformed --crop,
+// --csv/--plot without --profile-row).
 #pragma once
 #include <CLI/CLI.hpp>
 #include <optional>
@@ -15,6 +17,7 @@ struct CompareArgs {
   std::string test;
   std::string reference;
   bool json = false;
+  bool allowNonFinite = false;
   std::optional<std::string> crop;  // "x,y,w,h"
   std::optional<int> profileRow;
   std::optional<std::string> csv;

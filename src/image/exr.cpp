@@ -24,6 +24,7 @@
 
 #include "core/atomic_file.h"
 #include "image/exr_header_check.h"
+#include "image/image_limits.h"
 
 namespace tdpm::image {
 namespace {
@@ -131,7 +132,7 @@ void writeExrTo(const std::string& tempPath, const std::string& path, const ExrF
 // 65536 per side is also the largest image tdpm renders.
 void limitOpenExrSizes() {
   static const bool once = [] {
-    Imf::Header::setMaxImageSize(65536, 65536);
+    Imf::Header::setMaxImageSize(int(kMaxImageSide), int(kMaxImageSide));
     Imf::Header::setMaxTileSize(8192, 8192);
     return true;
   }();
@@ -151,7 +152,7 @@ ExrFile readExr(const std::string& path) {
     const Imath::Box2i dw = header.dataWindow();
     const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, h = int64_t(dw.max.y) - dw.min.y + 1;
     if (w <= 0 || h <= 0) throw Error(path + ": empty data window");
-    if (w * h > kMaxExrPixels)
+    if (w > kMaxImageSide || h > kMaxImageSide)  // checkExrHeader said so already; kept for the reasoning
       throw Error(path + ": image too large (" + std::to_string(w) + "x" + std::to_string(h) + ")");
     const size_t npix = size_t(w) * size_t(h);
     // Before allocating: a truncated file of a few bytes can declare a
@@ -159,23 +160,44 @@ ExrFile readExr(const std::string& path) {
     // gigabytes, then failed here anyway).
     if (!in.isComplete()) throw Error(path + ": truncated OpenEXR file (missing pixel data)");
 
-    // Which channels we can read: full resolution only.
+    // Which channels we can read: full resolution only, and only sets whose
+    // meaning is clear. X/Y/Z, luma/chroma (Y, RY, BY) or a lone R are not
+    // grey or colour: refused, never guessed.
     const Imf::ChannelList& channels = header.channels();
     auto fullRes = [&](const char* name) {
       const Imf::Channel* c = channels.findChannel(name);
       return c && c->xSampling == 1 && c->ySampling == 1;
     };
     const bool hasRgb = fullRes("R") && fullRes("G") && fullRes("B");
-    const bool hasY = !hasRgb && fullRes("Y");
-    if (!hasRgb && !hasY) {
+    bool hasY = false;
+    if (!hasRgb) {
+      // Grey: Y at full resolution, and no channel that would make Y part
+      // of another colour space: X (CIE XYZ), RY/BY (luma/chroma) or a
+      // partial R, G, B. (Z alone is EXR's depth channel; other names are
+      // extra data.)
+      bool onlyGrey = fullRes("Y");
       std::string present;
-      for (auto it = channels.begin(); it != channels.end(); ++it)
-        present += std::string(present.empty() ? "" : ", ") + it.name();
-      throw Error(path + ": no R, G, B (or Y) channels; the file has: " + (present.empty() ? "none" : present));
+      for (auto it = channels.begin(); it != channels.end(); ++it) {
+        const std::string name = it.name();
+        present += std::string(present.empty() ? "" : ", ") + name;
+        if (isColorName(name) || name == "X" || name == "RY" || name == "BY") onlyGrey = false;
+      }
+      if (!onlyGrey)
+        throw Error(path + ": channels not understood: the file has " + (present.empty() ? "none" : present) +
+                    "; tdpm reads R, G, B (colour) or Y without X, RY, BY or a partial R, G, B (grey), "
+                    "at full resolution; other channels are extra data");
+      hasY = true;
     }
+    // The decoded image and every extra channel, as floats.
+    size_t extraCount = 0;
+    for (auto it = channels.begin(); it != channels.end(); ++it) {
+      const std::string name = it.name();
+      if (hasRgb ? isColorName(name) : name == "Y") continue;
+      if (it.channel().xSampling == 1 && it.channel().ySampling == 1) ++extraCount;
+    }
+    checkDecodedImageFits(path, "OpenEXR", w, h, sizeof(Rgb) + sizeof(float) * extraCount);
 
     result.color = ImageRgb(int(w), int(h));
-    std::vector<float> grey;
     Imf::FrameBuffer fb;
     // Slice::Make offsets the base pointer by the data window origin, so a
     // window not starting at (0,0) (crops from other tools) lands at index 0.
@@ -186,8 +208,9 @@ ExrFile readExr(const std::string& path) {
       for (int c = 0; c < 3; ++c)
         fb.insert(rgbNames[c], Imf::Slice::Make(Imf::FLOAT, base + c * sizeof(float), dw, rgbX, rgbY));
     } else {
-      grey.resize(npix);
-      fb.insert("Y", Imf::Slice::Make(Imf::FLOAT, grey.data(), dw, sizeof(float), sizeof(float) * size_t(w)));
+      // Y into the red slot (no grey buffer the size of the image), copied
+      // to green and blue below.
+      fb.insert("Y", Imf::Slice::Make(Imf::FLOAT, base, dw, rgbX, rgbY));
     }
     for (auto it = channels.begin(); it != channels.end(); ++it) {
       const std::string name = it.name();
@@ -204,7 +227,7 @@ ExrFile readExr(const std::string& path) {
     in.readPixels(dw.min.y, dw.max.y);
 
     if (hasY)
-      for (size_t i = 0; i < npix; ++i) result.color.pixels[i] = Rgb(grey[i]);
+      for (Rgb& p : result.color.pixels) p = Rgb(p.r);
 
     for (auto it = header.begin(); it != header.end(); ++it)
       if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))

@@ -43,11 +43,15 @@ void writeExrTo(const std::string& tempPath, const std::string& path, const ExrF
 
 // Reads the data window of a flat (scanline or tiled) EXR, first part:
 //  * colour from R, G, B (any pixel type, converted to float); an image with
-//    Y and no R/G/B reads as grey (R = G = B = Y);
+//    Y reads as grey (R = G = B = Y) unless X (CIE XYZ), RY/BY (luma/chroma)
+//    or a partial R, G, B is present too: those sets, and files with neither
+//    R, G, B nor Y, are an error naming the channels found and understood;
 //  * every other full-resolution channel (HALF, FLOAT or UINT) as `extra`,
 //    in the file's (alphabetical) channel order; sub-sampled channels
 //    (e.g. luma/chroma RY, BY) are skipped;
 //  * all string attributes as metadata.
+// Admits every image tdpm writes (up to 65536 per side); what it allocates
+// is bounded by the file's size (checkExrHeader) and the memory available.
 // Any failure (missing or unreadable file, not an EXR, truncated or
 // corrupt data, deep image, no colour channels) throws tdpm::Error
 // "<path>: <reason>"; OpenEXR's own exceptions never escape.

@@ -7,8 +7,21 @@
 
 #include <map>
 
+#include "image/image_limits.h"
+
 namespace tdpm::image {
+
+uint64_t exrMaxCompressionRatio(int code) {
+  static const uint64_t ratios[10] = {1, 64, 1032, 1032, 1032, 1376, 11, 11, 66048, 66048};
+  return code >= 0 && code < 10 ? ratios[code] : 0;
+}
+
 namespace {
+
+const char* compressionName(int code) {
+  static const char* names[10] = {"NONE", "RLE", "ZIPS", "ZIP", "PIZ", "PXR24", "B44", "B44A", "DWAA", "DWAB"};
+  return code >= 0 && code < 10 ? names[code] : "unknown";
+}
 
 // Sequential reader that never reads past the end of the file and knows
 // how much is left, so a claimed size can be checked before it is used.
@@ -22,6 +35,7 @@ class Reader {
     std::fseek(f, 0, SEEK_SET);
   }
   uint64_t pos() const { return pos_; }
+  uint64_t size() const { return size_; }
   uint64_t left() const { return size_ - pos_; }
   bool bytes(void* out, uint64_t n) {
     if (n > left() || std::fread(out, 1, size_t(n), f_) != n) return false;
@@ -88,16 +102,17 @@ struct PartShape {
   int64_t width = 0, height = 0;
   bool hasTiles = false;
   uint32_t tileX = 0, tileY = 0;
+  int compression = -1;             // -1: no compression attribute (OpenEXR reports it)
+  uint64_t bytesPerPixel = 0;       // full-resolution channels, as stored (HALF 2, FLOAT and UINT 4)
 };
 
-std::string checkShape(const PartShape& s) {
+std::string checkShape(const PartShape& s, uint64_t fileSize) {
   if (!s.hasWindow) return "";  // OpenEXR reports the missing attribute itself
-  if (s.width <= 0 || s.height <= 0)
-    return "data window is empty (" + std::to_string(s.width) + "x" + std::to_string(s.height) + ")";
-  // Each side first: both can be near 2^32, and their product overflow.
-  if (s.width > kMaxExrPixels || s.height > kMaxExrPixels || s.width * s.height > kMaxExrPixels)
-    return "data window " + std::to_string(s.width) + "x" + std::to_string(s.height) + " is larger than " +
-           std::to_string(kMaxExrPixels) + " pixels";
+  const std::string size = std::to_string(s.width) + "x" + std::to_string(s.height);
+  if (s.width <= 0 || s.height <= 0) return "data window is empty (" + size + ")";
+  // Each side: both can be near 2^32, and their product overflow.
+  if (s.width > kMaxImageSide || s.height > kMaxImageSide)
+    return "data window " + size + " is larger than " + std::to_string(kMaxImageSide) + " pixels per side";
   if (s.hasTiles) {
     if (s.tileX == 0 || s.tileY == 0) return "tile size is zero";
     const int64_t tiles = ((s.width + s.tileX - 1) / s.tileX) * ((s.height + s.tileY - 1) / s.tileY);
@@ -105,6 +120,15 @@ std::string checkShape(const PartShape& s) {
       return std::to_string(s.tileX) + "x" + std::to_string(s.tileY) + " tiles make " + std::to_string(tiles) +
              " tiles, more than " + std::to_string(kMaxExrTiles);
   }
+  // What the pixels take decoded, against the most this file could hold:
+  // a few hundred bytes must not be able to claim gigabytes.
+  const uint64_t ratio = exrMaxCompressionRatio(s.compression);
+  if (s.compression < 0 || ratio == 0) return "";  // OpenEXR rejects a missing or unknown compression
+  const uint64_t decoded = uint64_t(s.width) * uint64_t(s.height) * s.bytesPerPixel;
+  if (decoded / ratio > fileSize)
+    return "data window " + size + " with " + std::to_string(s.bytesPerPixel) + " bytes per pixel needs " +
+           std::to_string(decoded) + " bytes decoded, more than a " + std::to_string(fileSize) + "-byte file holds with " +
+           compressionName(s.compression) + " compression (at most " + std::to_string(ratio) + " to 1)";
   return "";
 }
 
@@ -132,6 +156,12 @@ std::string checkValue(Reader& in, const std::string& name, const std::string& t
       shape.hasTiles = true;
       return "";
     }
+    if (type == "compression" && name == "compression") {
+      unsigned char code;
+      if (!in.bytes(&code, 1)) return truncated;
+      shape.compression = code;
+      return "";
+    }
     if (type == "int" && name == "chunkCount") {
       int32_t count;
       if (!in.i32(count)) return truncated;
@@ -144,10 +174,14 @@ std::string checkValue(Reader& in, const std::string& name, const std::string& t
   if (type == "chlist") {
     // Channels (name, pixel type, pLinear + 3 reserved, x and y sampling)
     // until an empty name; OpenEXR ignores the declared size here.
+    const bool isChannels = name == "channels";
+    if (isChannels) shape.bytesPerPixel = 0;  // a repeated attribute replaces the earlier one
     for (std::string channel;;) {
       if (!in.name(channel)) return truncated;
       if (channel.empty()) break;
-      if (!in.skip(16)) return truncated;
+      int32_t pixelType, xSampling, ySampling;
+      if (!in.i32(pixelType) || !in.skip(4) || !in.i32(xSampling) || !in.i32(ySampling)) return truncated;
+      if (isChannels && xSampling == 1 && ySampling == 1) shape.bytesPerPixel += pixelType == 1 ? 2 : 4;
       if (in.pos() - start > uint64_t(size)) break;
     }
     if (in.pos() - start != uint64_t(size))
@@ -193,7 +227,7 @@ std::string checkExrHeader(std::FILE* f) {
       std::string problem = checkValue(in, name, type, size, shape);
       if (!problem.empty()) return problem;
     }
-    std::string problem = checkShape(shape);
+    std::string problem = checkShape(shape, in.size());
     if (!problem.empty()) return problem;
     // A single-part file has one header; a multi-part file ends its list
     // of headers with an empty one.

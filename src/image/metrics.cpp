@@ -42,6 +42,16 @@ bool cropInside(const PixelRect& r, int width, int height) {
          int64_t(r.y) + r.h <= height;
 }
 
+NonFiniteValues findNonFinite(const ImageRgb& image, const PixelRect& region) {
+  TDPM_ASSERT(cropInside(region, image.width, image.height), "findNonFinite: region outside the image");
+  NonFiniteValues out;
+  for (int y = region.y; y < region.y + region.h; ++y)
+    for (int x = region.x; x < region.x + region.w; ++x)
+      for (int c = 0; c < 3; ++c)
+        if (!std::isfinite(image.at(x, y)[c]) && out.count++ == 0) out.x = x, out.y = y, out.channel = c;
+  return out;
+}
+
 std::optional<double> ImageMetrics::relativeMeanDifference() const {
   if (overall.meanRef == 0.0) return std::nullopt;
   return (overall.meanTest - overall.meanRef) / overall.meanRef;

@@ -43,13 +43,22 @@ struct ImageMetrics {
   size_t pixelCount = 0;    // region.w * region.h
   // Values (pixel channels) that were NaN or infinite. Like pbrt's imgtool,
   // they are counted as 0 so that one bad pixel does not turn every metric
-  // into NaN; the CLI warns when either count is not zero.
+  // into NaN; `tdpm compare` refuses such images unless --allow-nonfinite
+  // (an Inf where the reference is 0 would otherwise score 0 error).
   size_t nonFiniteTest = 0, nonFiniteRef = 0;
 
   // (mean test - mean ref) / mean ref over all channels: how much energy the
   // test image gained (> 0) or lost (< 0). Empty if the reference is black.
   std::optional<double> relativeMeanDifference() const;
 };
+
+// NaN or infinite values (pixel channels) of `image` inside `region`, and
+// where the first one is (row-major order); x = -1 when there is none.
+struct NonFiniteValues {
+  size_t count = 0;
+  int x = -1, y = -1, channel = -1;
+};
+NonFiniteValues findNonFinite(const ImageRgb& image, const PixelRect& region);
 
 // Compares `test` against `reference` over `region` (the whole image when
 // empty). Sizes must match and the region must be inside (cropInside); the

@@ -7,8 +7,11 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <vector>
 
 #include "core/atomic_file.h"
+#include "image/image_limits.h"
 
 namespace tdpm::image {
 
@@ -83,6 +86,70 @@ ImageRgb8 readPng(const std::string& path) {
     throw Error(path + ": cannot read PNG: " + why);
   }
   return out;
+}
+
+float srgbDecode(float v) {
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
+ImageRgb readPngLinear(const std::string& path) {
+  uint64_t fileSize = 0;
+  std::FILE* f = openRegularFile(path, fileSize);  // regular files only: png_image_begin_read would read /dev/zero
+  std::fclose(f);
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&png, path.c_str())) {
+    std::string why = png.message;
+    png_image_free(&png);
+    throw Error(path + ": cannot read PNG: " + why);
+  }
+  const int64_t w = png.width, h = png.height;
+  // 1 bit per pixel compressed at most 1032:1 by deflate: the pixels the
+  // file can hold, before anything is allocated for them.
+  const bool tooWide = w > kMaxImageSide || h > kMaxImageSide;
+  const bool tooMany = uint64_t(w) * uint64_t(h) / (8 * 1032) > fileSize;
+  if (tooWide || tooMany) {
+    png_image_free(&png);
+    throw Error(path + ": PNG image " + std::to_string(w) + "x" + std::to_string(h) +
+                (tooWide ? " is larger than " + std::to_string(kMaxImageSide) + " pixels per side"
+                         : " cannot be held by a file of " + std::to_string(fileSize) + " bytes"));
+  }
+  const bool sixteen = (png.format & PNG_FORMAT_FLAG_LINEAR) != 0;
+  try {
+    checkDecodedImageFits(path, "PNG", w, h, sizeof(Rgb) + (sixteen ? 6 : 4));
+  } catch (...) {
+    png_image_free(&png);
+    throw;
+  }
+  ImageRgb image(static_cast<int>(w), static_cast<int>(h));
+  auto fail = [&]() -> Error {
+    std::string why = png.message;
+    png_image_free(&png);
+    return Error(path + ": cannot read PNG: " + why);
+  };
+  if (sixteen) {
+    // libpng's linear output associates alpha (colour * alpha): divided
+    // out again to get the file's straight colour (lost where alpha is 0).
+    png.format = PNG_FORMAT_LINEAR_RGB_ALPHA;
+    std::vector<png_uint_16> px(size_t(w) * size_t(h) * 4);
+    if (!png_image_finish_read(&png, nullptr, px.data(), 0, nullptr)) throw fail();
+    for (size_t i = 0; i < image.pixelCount(); ++i) {
+      const float a = px[4 * i + 3];
+      const float k = a > 0 ? 1.0f / a : 0.0f;
+      image.pixels[i] = Rgb(px[4 * i] * k, px[4 * i + 1] * k, px[4 * i + 2] * k);
+    }
+  } else {
+    // RGBA, not RGB: without an alpha channel in the output libpng would
+    // composite onto a background; colour must stay the file's own.
+    png.format = PNG_FORMAT_RGBA;
+    std::vector<png_byte> px(size_t(w) * size_t(h) * 4);
+    if (!png_image_finish_read(&png, nullptr, px.data(), 0, nullptr)) throw fail();
+    float table[256];
+    for (int v = 0; v < 256; ++v) table[v] = srgbDecode(v / 255.0f);
+    for (size_t i = 0; i < image.pixelCount(); ++i)
+      image.pixels[i] = Rgb(table[px[4 * i]], table[px[4 * i + 1]], table[px[4 * i + 2]]);
+  }
+  return image;
 }
 
 std::string previewPathFor(const std::string& outputPath) {

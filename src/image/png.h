@@ -37,6 +37,25 @@ void writePngPreviewTo(const std::string& tempPath, const std::string& path, con
 // tdpm::Error "<path>: <reason>".
 ImageRgb8 readPng(const std::string& path);
 
+// sRGB electro-optical transfer function (IEC 61966-2-1): code value in
+// [0,1] to linear.
+float srgbDecode(float encoded);
+
+// Reads any PNG (grey, RGB, palette, with or without alpha; 1- to 16-bit)
+// as linear RGB for `compare`, through libpng's simplified API, which also
+// applies the file's gAMA/sRGB/cHRM information:
+//  * 8-bit and lower files are read as 8-bit sRGB codes and decoded exactly
+//    with srgbDecode (so values are the 256 sRGB levels);
+//  * 16-bit files are read as libpng's 16-bit linear values (v / 65535);
+//    note libpng's rule that a 16-bit file without gAMA or sRGB chunk is
+//    already linear. libpng associates alpha in linear output; it is
+//    divided out again (colour where alpha is 0 reads as black).
+// Alpha is not applied: colour is PNG's straight (unassociated) colour.
+// Each side at most 65536, and width * height bounded by what the file's
+// size can hold (deflate's 1032:1 at 1 bit per pixel); throws tdpm::Error
+// "<path>: <reason>".
+ImageRgb readPngLinear(const std::string& path);
+
 // The preview's path for an output path: the extension of the last path
 // component replaced by ".png" ("out.exr" -> "out.png", "dir.v2/out" ->
 // "dir.v2/out.png", ".hidden" -> ".hidden.png"). If the output itself ends
