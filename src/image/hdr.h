@@ -21,7 +21,8 @@ namespace tdpm::image {
 // Reads an RGBE Radiance file into linear RGB, row 0 at the top, each
 // value divided by the product of the header's EXPOSURE values (Radiance's
 // definition: EXPOSURE is a factor already applied to the pixels).
-// FORMAT=32-bit_rle_xyze (CIE XYZ) is refused. Scanlines are decoded into
+// FORMAT=32-bit_rle_xyze (CIE XYZ) is refused; PRIMARIES and COLORCORR
+// lines are ignored (pixels are taken as the same RGB as the other image). Scanlines are decoded into
 // a buffer that grows only with decoded data, so a short file never makes
 // it allocate the declared size; the declared size is checked against the
 // memory available before decoding. Throws tdpm::Error "<path>: <reason>",
