@@ -15,7 +15,8 @@ namespace {
 constexpr int kRouletteStartDepth = 3;
 }
 
-Rgb PathTracer::radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const {
+template <class Stream>
+Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler) const {
   Rgb L(0.0f), beta(1.0f);
   bool lastDelta = true;  // the camera ray counts as "specular": no MIS on a direct hit
   float lastPdf = 0.0f;
@@ -41,12 +42,12 @@ Rgb PathTracer::radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const 
     ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
 
     // ---- next-event estimation ----
-    if (!mat.isDeltaOnly()) L += beta * directLight(scene_, hit, ctx, time01, rng, /*bsdfSamples=*/1);
+    if (!mat.isDeltaOnly()) L += beta * directLight(scene_, hit, ctx, time01, sampler, depth, /*bsdfSamples=*/1);
 
     // ---- continue the path ----
     BsdfSample bs;
-    Vec2f u{rng.uniform(), rng.uniform()};
-    if (!bsdfSample(ctx, u, rng.uniform(), Transport::Radiance, bs)) break;
+    Vec3f ub = sampler.get3D(dims::vertexGroup(depth, dims::kBsdf));
+    if (!bsdfSample(ctx, {ub.x, ub.y}, ub.z, Transport::Radiance, bs)) break;
     beta *= bs.weight;
     if (beta.isBlack() || !isFinite(beta)) break;
     lastDelta = bs.delta;
@@ -57,11 +58,14 @@ Rgb PathTracer::radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const 
 
     if (depth + 1 >= kRouletteStartDepth) {
       float survive = std::min(0.95f, beta.maxComponent());
-      if (rng.uniform() >= survive) break;
+      if (sampler.get1D(dims::vertexGroup(depth, dims::kRoulette)) >= survive) break;
       beta = beta / survive;
     }
   }
   return L;
 }
+
+template Rgb PathTracer::trace<RandomStream>(Vec3f, Vec3f, float, RandomStream&) const;
+template Rgb PathTracer::trace<SobolStream>(Vec3f, Vec3f, float, SobolStream&) const;
 
 }  // namespace tdpm
