@@ -189,6 +189,7 @@ RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc,
   o.maxSpp = pick(a.maxSpp, sc.maxSpp, o.spp);
   o.contrast = pick(a.contrast, sc.contrast, o.contrast);
   o.seed = a.seed ? uint64_t(*a.seed) : sc.seed.value_or(o.seed);
+  parseSamplerKind(pick(a.sampler, sc.sampler, std::string(samplerName(o.sampler))), o.sampler);  // both checked already
   o.maxDepth = pick(a.maxDepth, sc.maxDepth, o.maxDepth);
   o.causticPhotons = size_t(pick(a.photons, sc.photons, int64_t(o.causticPhotons)));
   o.globalPhotons = size_t(pick(a.globalPhotons, sc.globalPhotons, int64_t(o.globalPhotons)));
@@ -273,6 +274,9 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
       ->check(CLI::PositiveNumber);
   c->add_option("--seed", a.seed, "Random seed >= 0: same seed, same image, whatever --threads is")
       ->check(CLI::NonNegativeNumber);
+  c->add_option("--sampler", a.sampler,
+                 "Sample generator: sobol (Owen-scrambled Sobol, every dimension) or random (PCG32) (default sobol)")
+      ->check(CLI::IsMember({"random", "sobol"}));
   c->add_option("--max-depth", a.maxDepth, "Maximum path length in vertices (default 16)")->check(rangeOf(limits::kMaxDepth));
   c->add_option("--resolution", a.resolution, "Image size WxH (overrides the scene), e.g. 640x480");
   c->add_option("--exposure", a.exposure, "PNG preview exposure in stops (the EXR is unaffected)")
@@ -385,6 +389,7 @@ int runRender(const RenderArgs& a) {
                   {"tdpm/max_spp", std::to_string(opt.maxSpp)},
                   {"tdpm/spp_taken", std::to_string(stats.minSpp) + "-" + std::to_string(stats.maxSpp)},
                   {"tdpm/seed", std::to_string(opt.seed)},
+                  {"tdpm/sampler", samplerName(opt.sampler)},
                   {"tdpm/max_depth", std::to_string(opt.maxDepth)},
                   {"tdpm/render_seconds", seconds}};
   bool photonMethod = opt.method != "pathtrace";

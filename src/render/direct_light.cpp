@@ -7,12 +7,14 @@
 
 namespace tdpm {
 
-Rgb directLight(const Scene& scene, const Hit& hit, const ShadingContext& ctx, float time01, Rng& rng,
-                int bsdfSamples) {
+template <class Stream>
+Rgb directLight(const Scene& scene, const Hit& hit, const ShadingContext& ctx, float time01, Stream& sampler,
+                int vertex, int bsdfSamples) {
   Rgb sum(0.0f);
-  for (const Light& light : scene.lights) {
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& light = scene.lights[i];
     LightSample ls;
-    Vec2f u{rng.uniform(), rng.uniform()};
+    Vec2f u = sampler.get2D(dims::vertexGroup(vertex, dims::kLightPosition, uint32_t(i)));
     if (!sampleLight(light, hit.p, time01, u, ls)) continue;
     Rgb f = bsdfEval(ctx, ls.wi);
     if (f.isBlack()) continue;
@@ -30,5 +32,8 @@ Rgb directLight(const Scene& scene, const Hit& hit, const ShadingContext& ctx, f
   }
   return sum;
 }
+
+template Rgb directLight<RandomStream>(const Scene&, const Hit&, const ShadingContext&, float, RandomStream&, int, int);
+template Rgb directLight<SobolStream>(const Scene&, const Hit&, const ShadingContext&, float, SobolStream&, int, int);
 
 }  // namespace tdpm

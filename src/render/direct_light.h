@@ -6,13 +6,18 @@
 // at full weight (the caller then ignores emission its rays hit).
 #pragma once
 #include "core/rng.h"
+#include "sampling/sampler.h"
 #include "scene/bsdf.h"
 #include "scene/scene.h"
 
 namespace tdpm {
 
-Rgb directLight(const Scene& scene, const Hit& hit, const ShadingContext& ctx, float time01, Rng& rng,
-                int bsdfSamples);
+// `vertex` is the path vertex (sampling/sampler.h dimension order): light
+// i's point is drawn from group vertexGroup(vertex, kLightPosition, i).
+// Defined for RandomStream and SobolStream.
+template <class Stream>
+Rgb directLight(const Scene& scene, const Hit& hit, const ShadingContext& ctx, float time01, Stream& sampler,
+                int vertex, int bsdfSamples);
 
 // MIS weight of a BSDF-sampled ray (one of `bsdfSamples`, density
 // bsdfPdf) that hit an area light which light sampling would have chosen

@@ -15,8 +15,14 @@ namespace {
 constexpr int kRouletteStartDepth = 3;
 }
 
-Rgb PathTracer::radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const {
+template <class Stream>
+Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler) const {
   Rgb L(0.0f), beta(1.0f);
+  // Product of eta^2 over the refractions so far: the radiance scaling
+  // 1/eta^2 a refraction puts into beta is undone for Russian roulette,
+  // which should judge the path's energy, not its being inside glass
+  // (inside the ball beta is 1/2.25 of what it will be again outside).
+  float etaScale = 1.0f;
   bool lastDelta = true;  // the camera ray counts as "specular": no MIS on a direct hit
   float lastPdf = 0.0f;
   Vec3f lastP = origin;
@@ -41,27 +47,37 @@ Rgb PathTracer::radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const 
     ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
 
     // ---- next-event estimation ----
-    if (!mat.isDeltaOnly()) L += beta * directLight(scene_, hit, ctx, time01, rng, /*bsdfSamples=*/1);
+    if (!mat.isDeltaOnly()) L += beta * directLight(scene_, hit, ctx, time01, sampler, depth, /*bsdfSamples=*/1);
 
     // ---- continue the path ----
     BsdfSample bs;
-    Vec2f u{rng.uniform(), rng.uniform()};
-    if (!bsdfSample(ctx, u, rng.uniform(), Transport::Radiance, bs)) break;
+    Vec3f ub = sampler.get3D(dims::vertexGroup(depth, dims::kBsdf));
+    if (!bsdfSample(ctx, {ub.x, ub.y}, ub.z, Transport::Radiance, bs)) break;
     beta *= bs.weight;
     if (beta.isBlack() || !isFinite(beta)) break;
+    if (bs.delta && mat.type == Material::Type::Dielectric && (dot(bs.wi, hit.n) < 0) != (dot(-dir, hit.n) < 0)) {
+      float eta = dot(-dir, hit.n) > 0 ? mat.ior : 1.0f / mat.ior;  // eta_t / eta_i
+      etaScale *= eta * eta;
+    }
     lastDelta = bs.delta;
     lastPdf = bs.pdf;
     lastP = hit.p;
     origin = scene_.spawnOrigin(hit.p, hit.n, bs.wi);
     dir = bs.wi;
 
-    if (depth + 1 >= kRouletteStartDepth) {
-      float survive = std::min(0.95f, beta.maxComponent());
-      if (rng.uniform() >= survive) break;
+    // Roulette only a path whose weight has fallen below 1 (a path at full
+    // weight gains nothing from being killed 5% of the time).
+    float rr = beta.maxComponent() * etaScale;
+    if (depth + 1 >= kRouletteStartDepth && rr < 1.0f) {
+      float survive = rr;
+      if (sampler.get1D(dims::vertexGroup(depth, dims::kRoulette)) >= survive) break;
       beta = beta / survive;
     }
   }
   return L;
 }
+
+template Rgb PathTracer::trace<RandomStream>(Vec3f, Vec3f, float, RandomStream&) const;
+template Rgb PathTracer::trace<SobolStream>(Vec3f, Vec3f, float, SobolStream&) const;
 
 }  // namespace tdpm

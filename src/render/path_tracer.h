@@ -7,6 +7,7 @@
 // by it: reference scenes for caustics use area lights.
 #pragma once
 #include "core/rng.h"
+#include "sampling/sampler.h"
 #include "scene/scene.h"
 
 namespace tdpm {
@@ -17,8 +18,19 @@ class PathTracer {
 
   // Radiance arriving at `origin` from direction `dir`, at time time01.
   struct ThreadState {};
+  // Stream: RandomStream or SobolStream (sampling/sampler.h); draws follow
+  // its dimension order, vertex = depth.
+  template <class Stream>
+  Rgb radiance(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState&) const {
+    return trace(origin, dir, time01, sampler);
+  }
   Rgb radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng, ThreadState&) const { return radiance(origin, dir, time01, rng); }
-  Rgb radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const;
+  Rgb radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const {
+    RandomStream s{&rng};
+    return trace(origin, dir, time01, s);
+  }
+  template <class Stream>
+  Rgb trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler) const;
   void flush(ThreadState&) const {}
 
  private:

@@ -63,13 +63,14 @@ Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::G
   return g3->standard(hit.p, n, wo, brdf, nullptr, tag);
 }
 
-Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, float time01, bool touched, Rng& rng,
-                                  ThreadState& ts) const {
+template <class Stream>
+Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, float time01, bool touched,
+                                  Stream& sampler, int vertex, ThreadState& ts) const {
   Rgb sum(0.0f);
   for (int i = 0; i < s_.gatherRays; ++i) {
     BsdfSample bs;
-    Vec2f u{rng.uniform(), rng.uniform()};
-    if (!bsdfSample(ctx, u, rng.uniform(), Transport::Radiance, bs)) continue;
+    Vec3f u = sampler.get3D(dims::vertexGroup(vertex, dims::kGather, uint32_t(i)));
+    if (!bsdfSample(ctx, {u.x, u.y}, u.z, Transport::Radiance, bs)) continue;
     Rgb beta = bs.weight;
     Vec3f o = scene_.spawnOrigin(hit.p, hit.n, bs.wi), d = bs.wi;
     bool moved = touched;
@@ -99,8 +100,8 @@ Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, flo
         break;
       }
       BsdfSample sb;
-      Vec2f u2{rng.uniform(), rng.uniform()};
-      if (!bsdfSample(c, u2, rng.uniform(), Transport::Radiance, sb)) break;
+      Vec3f u2 = sampler.get3D(dims::vertexGroup(vertex + 1 + bounce, dims::kGather, uint32_t(i)));
+      if (!bsdfSample(c, {u2.x, u2.y}, u2.z, Transport::Radiance, sb)) break;
       beta *= sb.weight;
       o = scene_.spawnOrigin(h.p, h.n, sb.wi);
       d = sb.wi;
@@ -109,7 +110,8 @@ Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, flo
   return sum / float(s_.gatherRays);
 }
 
-Rgb PhotonIntegrator::radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng, ThreadState& ts) const {
+template <class Stream>
+Rgb PhotonIntegrator::radiance(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts) const {
   Rgb L(0.0f), beta(1.0f);
   // A moving camera sees a different surface point at each time: never
   // the fixed-point time average, so always the time-dependent estimate.
@@ -141,16 +143,16 @@ Rgb PhotonIntegrator::radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng, 
         break;
       }
       bool gather = global_ && global_->size() > 0 && s_.gatherRays > 0;
-      L += beta * directLight(scene_, hit, ctx, time01, rng, gather ? s_.gatherRays : 0);
+      L += beta * directLight(scene_, hit, ctx, time01, sampler, depth, gather ? s_.gatherRays : 0);
       L += beta * estimate(caustic_, ts.caustic, ts.caustic3, hit, ctx, -dir, time01, timeDependent, ts.counts);
-      if (gather) L += beta * finalGather(hit, ctx, time01, touched, rng, ts);
+      if (gather) L += beta * finalGather(hit, ctx, time01, touched, sampler, depth, ts);
       break;
     }
 
     // ---- mirror / glass: follow one branch ----
     BsdfSample bs;
-    Vec2f u{rng.uniform(), rng.uniform()};
-    if (!bsdfSample(ctx, u, rng.uniform(), Transport::Radiance, bs)) break;
+    Vec3f u = sampler.get3D(dims::vertexGroup(depth, dims::kBsdf));
+    if (!bsdfSample(ctx, {u.x, u.y}, u.z, Transport::Radiance, bs)) break;
     beta *= bs.weight;
     if (beta.isBlack() || !isFinite(beta)) break;
     lastDelta = true;
@@ -159,5 +161,8 @@ Rgb PhotonIntegrator::radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng, 
   }
   return L;
 }
+
+template Rgb PhotonIntegrator::radiance<RandomStream>(Vec3f, Vec3f, float, RandomStream&, ThreadState&) const;
+template Rgb PhotonIntegrator::radiance<SobolStream>(Vec3f, Vec3f, float, SobolStream&, ThreadState&) const;
 
 }  // namespace tdpm

@@ -17,6 +17,7 @@
 #include "core/rng.h"
 #include "estimate/estimators.h"
 #include "render/photon_map.h"
+#include "sampling/sampler.h"
 #include "scene/scene.h"
 
 namespace tdpm {
@@ -44,7 +45,13 @@ class PhotonIntegrator {
   PhotonIntegrator(const Scene& scene, const PhotonMap* caustic, const PhotonMap* global,
                    const PhotonIntegratorSettings& settings);
 
-  Rgb radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng, ThreadState& ts) const;
+  // Stream: RandomStream or SobolStream (sampling/sampler.h dimension order).
+  template <class Stream>
+  Rgb radiance(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts) const;
+  Rgb radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng, ThreadState& ts) const {
+    RandomStream s{&rng};
+    return radiance(origin, dir, time01, s, ts);
+  }
   // Moves a thread's counters into the totals (called once per tile).
   void flush(ThreadState& ts) const;
   EstimateCounts counts() const;
@@ -53,8 +60,9 @@ class PhotonIntegrator {
   Rgb estimate(const PhotonMap* map, std::unique_ptr<estimate::Gatherer>& g, std::unique_ptr<estimate::Gatherer>& g3,
                const Hit& hit, const struct ShadingContext& ctx, Vec3f wo, float time01, bool timeDependent,
                EstimateCounts& counts) const;
-  Rgb finalGather(const Hit& hit, const struct ShadingContext& ctx, float time01, bool touched, Rng& rng,
-                  ThreadState& ts) const;
+  template <class Stream>
+  Rgb finalGather(const Hit& hit, const struct ShadingContext& ctx, float time01, bool touched, Stream& sampler,
+                  int vertex, ThreadState& ts) const;
 
   const Scene& scene_;
   const PhotonMap* caustic_;

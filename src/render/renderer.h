@@ -10,20 +10,33 @@
 #include "core/progress.h"
 #include "estimate/estimators.h"
 #include "render/film.h"
+#include "sampling/sampler.h"
 #include "scene/scene.h"
 
 namespace tdpm {
 
+// Adaptive sampling never stops a pixel before this many samples. A pixel
+// whose value is carried by paths of probability q per sample misses all
+// of them in its first N samples with probability (1 - q)^N; its
+// neighbours, which decide when it stops (renderer.cpp), miss them in all
+// 8 x 64 = 512 of theirs with probability (1 - q)^512: below 1% for
+// q >= 0.9%. With fewer, a neighbourhood that has not yet met its caustic
+// paths looks converged. The stopping decision is independent of the
+// pixel's own samples, so this bounds how much is wasted, not the bias.
+inline constexpr int kAdaptiveMinSamples = 64;
+
 struct RenderOptions {
   std::string method = "time";  // pathtrace | static | accumulation | standard | time
-  // Adaptive sampling: every pixel takes `spp` stratified samples, then
-  // further batches of `spp` while its contrast (relative standard error of
-  // the mean luminance, see renderer.cpp) exceeds `contrast`, up to maxSpp.
+  // Adaptive sampling: every pixel takes `spp` samples, then further
+  // batches of `spp` while the relative error of its mean luminance (judged
+  // from two interleaved half-buffers over its 3x3 neighbourhood, at least
+  // 64 samples, see renderer.cpp) exceeds `contrast`, up to maxSpp.
   // maxSpp <= spp: exactly spp samples everywhere.
   int spp = 16;
   int maxSpp = 0;
   float contrast = 0.05f;
   uint64_t seed = 1;
+  SamplerKind sampler = SamplerKind::Sobol;  // sampling/sampler.h
   int maxDepth = 16;
 
   // ---- photon methods ----

@@ -116,6 +116,7 @@ struct RenderSettings {
   std::optional<int> maxSpp;          // adaptive maximum, >= 1
   std::optional<float> contrast;      // adaptive threshold, > 0
   std::optional<uint64_t> seed;
+  std::optional<std::string> sampler; // random | sobol
   std::optional<int> maxDepth;        // path vertices, >= 1
   std::optional<float> exposure;      // PNG preview: stops
   // photon methods

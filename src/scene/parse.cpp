@@ -661,19 +661,21 @@ uint64_t readSeed(const Node& n) {
 const std::vector<std::string> kMethods = {"pathtrace", "static", "accumulation", "standard", "time"};
 
 const std::vector<std::string> kSearches = {"twopass", "4d"};
+const std::vector<std::string> kSamplers = {"random", "sobol"};
 const std::vector<std::string> kSpaceKernels = {"uniform", "cone", "epanechnikov"};
 const std::vector<std::string> kTimeKernels = {"uniform", "epanechnikov"};
 
 RenderSettings readRender(const Node& n, float shutterLength) {
   n.expectObject({"method", "spp", "max_spp", "contrast", "seed", "max_depth", "exposure", "photons", "global_photons",
                   "frames", "search", "k", "fraction", "kappa", "max_radius", "max_dt", "kernel_space", "kernel_time",
-                  "gather"});
+                  "gather", "sampler"});
   RenderSettings r;
   if (n.has("method")) r.method = n.member("method").choice(kMethods, "render method");
   if (n.has("spp")) r.spp = readCount(n.member("spp"), "spp", limits::kSpp);
   if (n.has("max_spp")) r.maxSpp = readCount(n.member("max_spp"), "max_spp", limits::kSpp);
   if (n.has("contrast")) r.contrast = readPositive(n.member("contrast"), "contrast");
   if (n.has("seed")) r.seed = readSeed(n.member("seed"));
+  if (n.has("sampler")) r.sampler = n.member("sampler").choice(kSamplers, "sampler");
   if (n.has("max_depth")) r.maxDepth = readCount(n.member("max_depth"), "max_depth", limits::kMaxDepth);
   if (n.has("exposure")) r.exposure = readFloatInRange(n.member("exposure"), "exposure", limits::kExposure);
   if (n.has("photons")) r.photons = readInRange(n.member("photons"), "photons", limits::kPhotons);
