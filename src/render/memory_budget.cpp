@@ -44,7 +44,7 @@ PhotonCounts photonCounts(const Scene& scene, const RenderOptions& opt) {
 
 }  // namespace
 
-uint64_t MemoryEstimate::peak() const { return std::max(films + samples + photons, write); }
+uint64_t MemoryEstimate::peak() const { return std::max(films + sampler + samples + photons, write); }
 
 MemoryEstimate estimateRenderMemory(const Scene& scene, const RenderOptions& opt, int threads) {
   MemoryEstimate e;
@@ -52,6 +52,7 @@ MemoryEstimate estimateRenderMemory(const Scene& scene, const RenderOptions& opt
   // accumulation keeps the result, the running sum and the current frame.
   const uint64_t films = opt.method == "accumulation" && scene.hasMotion && opt.frames > 1 ? 3 : 1;
   e.films = films * kFilmBytesPerPixel * e.pixels;
+  e.sampler = kSamplerBytesPerPixel * e.pixels;  // one film is sampled at a time
   e.samples = uint64_t(std::max(1, threads)) * uint64_t(std::max(1, opt.spp)) * kSampleBytes;
   PhotonCounts p = photonCounts(scene, opt);
   e.photons = photonMemoryBytes(p.caustic, p.global, p.spaceTime, opt.maxDepth);
@@ -66,7 +67,7 @@ void checkMemoryBudget(const Scene& scene, const RenderOptions& opt, int threads
   const uint64_t usable = available > margin ? available - margin : 0;
   if (e.peak() <= usable) return;
   const PhotonCounts p = photonCounts(scene, opt);
-  const uint64_t imageAlone = std::max(e.films + e.samples, e.write);
+  const uint64_t imageAlone = std::max(e.films + e.sampler + e.samples, e.write);
   // The photons alone do not fit: the photon budget's own message.
   if (imageAlone <= usable && e.photons > usable)
     checkPhotonMemory(p.caustic, p.global, p.spaceTime, opt.maxDepth, available, opt.causticPhotonsSource,
@@ -74,7 +75,7 @@ void checkMemoryBudget(const Scene& scene, const RenderOptions& opt, int threads
   const std::string image = opt.resolutionSource + " (" + std::to_string(scene.camera.width()) + "x" +
                             std::to_string(scene.camera.height()) + " = " + std::to_string(e.pixels) + " pixels)";
   const std::string imageNeeds =
-      formatBytes(imageAlone) + " for the image (" + std::to_string(e.films / std::max<uint64_t>(1, e.pixels)) +
+      formatBytes(imageAlone) + " for the image (" + std::to_string((e.films + e.sampler) / std::max<uint64_t>(1, e.pixels)) +
       " bytes per pixel while rendering, " + std::to_string(kWriteBytesPerPixel) + " while writing the EXR and PNG)";
   const std::string limits = ", but only " + formatBytes(usable) + " of memory is available (MemAvailable " +
                              formatBytes(available) + " less a margin of " + formatBytes(margin) + ")";

@@ -26,10 +26,11 @@ constexpr uint64_t kSampleBytes = 24;
 struct MemoryEstimate {
   uint64_t pixels = 0;
   uint64_t films = 0;    // the films alive while rendering (accumulation: 3)
+  uint64_t sampler = 0;  // the adaptive loop's per-pixel state (kSamplerBytesPerPixel)
   uint64_t samples = 0;  // per-thread batch buffers
   uint64_t photons = 0;  // photonMemoryBytes of the maps traced (one frame's for accumulation)
   uint64_t write = 0;    // the EXR and PNG buffers while writing
-  // The most held at once: rendering (films + samples + photons) or writing.
+  // The most held at once: rendering (films + sampler + samples + photons) or writing.
   uint64_t peak() const;
 };
 

@@ -40,17 +40,17 @@ const char* const kMethods[] = {"pathtrace", "static", "accumulation", "standard
 // that has not yet met its rare bright paths).
 struct PixelAccumulator {
   Rgb mean{0.0f};
+  // A pixel's sample indices are 0..n-1 (passes continue them and a pixel
+  // that stops never resumes), so the halves hold (n + 1) / 2 and n / 2.
+  int n = 0;  // here, not last: it fills the 4 bytes before the doubles
   double m2[3] = {0, 0, 0};
   double halfLum[2] = {0, 0};  // sums of luminance, even / odd sample indices
-  int halfN[2] = {0, 0};
-  int n = 0;
   void add(Rgb v, uint32_t index) {
     ++n;
     Rgb d = v - mean;
     mean += d / float(n);
     for (int c = 0; c < 3; ++c) m2[c] += double(d[c]) * double(v[c] - mean[c]);
     halfLum[index & 1] += double(v.luminance());
-    ++halfN[index & 1];
   }
   Rgb varianceOfMean() const {
     if (n < 2) return Rgb(0.0f);
@@ -63,13 +63,17 @@ struct PixelAccumulator {
   // |A - B| / 2 estimates the standard error, divided by the mean (plus a
   // floor, so near-black pixels are judged on absolute error).
   double halfError() const {
-    if (halfN[0] == 0 || halfN[1] == 0) return std::numeric_limits<double>::infinity();
-    double a = halfLum[0] / halfN[0], b = halfLum[1] / halfN[1];
-    double all = (halfLum[0] + halfLum[1]) / (halfN[0] + halfN[1]);
+    if (n < 2) return std::numeric_limits<double>::infinity();
+    double a = halfLum[0] / double((n + 1) / 2), b = halfLum[1] / double(n / 2);
+    double all = (halfLum[0] + halfLum[1]) / double(n);
     return 0.5 * std::fabs(a - b) / (std::fabs(all) + kContrastFloor);
   }
   static constexpr double kContrastFloor = 0.02;
 };
+// What the memory pre-flight (render/memory_budget.h) charges per pixel for
+// the adaptive loop: an accumulator, the activity flag and the half error.
+static_assert(sizeof(PixelAccumulator) + sizeof(uint8_t) + sizeof(float) == kSamplerBytesPerPixel,
+              "update kSamplerBytesPerPixel in render/renderer.h");
 
 // NaN -> 0, +-Inf -> +-FLT_MAX, per channel.
 Rgb saturateSample(Rgb L) {
@@ -150,21 +154,21 @@ void renderPixelsWith(const Scene& scene, const Integrator& integrator, const Sa
   const size_t n = size_t(w) * size_t(h);
   std::vector<PixelAccumulator> accs(n);
   std::vector<uint8_t> active(n, 1);
-  std::vector<double> err(n);
+  std::vector<float> err(n);
   uint32_t taken = 0;
   for (int pass = 0;; ++pass) {
     std::string name = pass == 0 ? std::string(stage) : std::string(stage) + " (adaptive pass " + std::to_string(pass) + ")";
     samplePass<PixelSampler>(scene, integrator, plan, taken, plan.batch, active, accs, name, progress, w, h);
     taken += uint32_t(plan.batch);
     if (int(taken) + plan.batch > plan.maxSpp) break;
-    for (size_t i = 0; i < n; ++i) err[i] = accs[i].halfError();
+    for (size_t i = 0; i < n; ++i) err[i] = float(std::min(accs[i].halfError(), double(FLT_MAX)));
     bool any = false;
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
         size_t idx = size_t(y) * size_t(w) + size_t(x);
         if (!active[idx]) continue;
         if (int(taken) < kAdaptiveMinSamples) { any = true; continue; }
-        double e = 0;
+        float e = 0;
         for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy)
           for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx)
             if (xx != x || yy != y) e = std::max(e, err[size_t(yy) * size_t(w) + size_t(xx)]);

@@ -24,6 +24,10 @@ namespace tdpm {
 // paths looks converged. The stopping decision is independent of the
 // pixel's own samples, so this bounds how much is wasted, not the bias.
 inline constexpr int kAdaptiveMinSamples = 64;
+// Bytes per pixel the adaptive loop holds while a film is rendered
+// (renderer.cpp checks it against its types): a pixel accumulator (56), its
+// activity flag (1) and its half-buffer error (4).
+inline constexpr uint64_t kSamplerBytesPerPixel = 61;
 
 struct RenderOptions {
   std::string method = "time";  // pathtrace | static | accumulation | standard | time
