@@ -240,7 +240,7 @@ TEST_CASE("photon tracing: a narrow spot is emitted through its own cone, not th
     photon::TraceResult without = photon::tracePhotons(*s, ts, Progress{});
     double a = totalEnergy(with.store), b = totalEnergy(without.store);
     double rate = double(with.store.size()) / double(with.emitted);
-    INFO(c.what << ": with projection " << a << " J, " << with.store.size() << " stored of " << with.emitted
+    INFO(std::string(c.what) << ": with projection " << a << " J, " << with.store.size() << " stored of " << with.emitted
                 << " paths; without " << b << " J, " << without.store.size() << " of " << without.emitted);
     REQUIRE(b > 0);
     CHECK(a == doctest::Approx(b).epsilon(0.03));
