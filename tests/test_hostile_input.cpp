@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "error_capture.h"
 #include "cli_harness.h"
 #include "core/error.h"
 #include "image/exr.h"
@@ -33,21 +34,11 @@ namespace {
 const std::string kFile = "h.json";
 
 std::string errorOf(const std::string& text, const std::string& file = kFile) {
-  try {
-    parseScene(text, file);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
+  return test::errorMessageOf([&] { parseScene(text, file); });
 }
 
 std::string loadError(const std::string& path) {
-  try {
-    loadScene(path);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
+  return test::errorMessageOf([&] { loadScene(path); });
 }
 
 Json baseScene() {

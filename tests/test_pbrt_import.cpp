@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "error_capture.h"
 #include "core/error.h"
 #include "import/pbrt_import.h"
 #include "import/pbrt_math.h"
@@ -41,12 +42,7 @@ scene::SceneDescription importText(const std::string& text, const std::string& f
 }
 
 std::string errorOf(const std::string& text, const std::string& file = "dir/t.pbrt") {
-  try {
-    pbrt::importPbrtText(text, file);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
+  return test::errorMessageOf([&] { pbrt::importPbrtText(text, file); });
 }
 
 Film renderDesc(const scene::SceneDescription& d, const std::string& method = "pathtrace", int spp = 4) {

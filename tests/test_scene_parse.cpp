@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "error_capture.h"
 #include "core/error.h"
 #include "scene/json_locate.h"
 #include "scene/parse.h"
@@ -33,21 +34,11 @@ const std::string kData = std::string(TDPM_SOURCE_DIR) + "/tests/data";
 
 // The message of the tdpm::Error thrown for `text`, or "(no error)".
 std::string errorOf(const std::string& text, const std::string& file = kFile) {
-  try {
-    parseScene(text, file);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
+  return test::errorMessageOf([&] { parseScene(text, file); });
 }
 
 std::string loadError(const std::string& path) {
-  try {
-    loadScene(path);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
+  return test::errorMessageOf([&] { loadScene(path); });
 }
 
 // A small valid scene that the bad-input tests break one piece at a time.
