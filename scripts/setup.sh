@@ -56,7 +56,7 @@ case "$mode" in
     build/tdpm render scenes/glass-ball.json -o glass-ball.exr
     ;;
   test)
-    # A short fuzzing run of the scene loader and the EXR reader with a fixed
+    # A short fuzzing run of the four loaders (scene, EXR, pbrt, PFM/HDR/PNG) with a fixed
     # seed and input count (CI does not fail by luck, a failure replays;
     # about 1.5 min with its clang build on 2 cores: 53 s of build and 29 s of fuzzing on a clean clone), first, so that
     # CTest's summary is the last thing printed.
