@@ -28,8 +28,8 @@ Film renderScene(const scene::SceneDescription& d, int spp, int maxDepth = 16, u
 }
 
 // Radiance seen from `eye` toward point q, averaged over n paths.
-Rgb meanRadiance(const Scene& s, Vec3f eye, Vec3f q, int n, uint64_t seed = 3) {
-  PathTracer pt(s, 8);
+Rgb meanRadiance(const Scene& s, Vec3f eye, Vec3f q, int n, uint64_t seed = 3, int maxDepth = 8) {
+  PathTracer pt(s, maxDepth);
   Rng rng(seed);
   Rgb sum(0.0f);
   for (int i = 0; i < n; ++i) sum += pt.radiance(eye, normalize(q - eye), 0.5f, rng);
@@ -119,6 +119,12 @@ TEST_CASE("radiometry: rectangular area light (NEE + MIS) matches Lambert's cont
   float E = polygonIrradiance(corners, L);
   Rgb got = meanRadiance(*s, {1.0f, 0.5f, 1.5f}, {0, 0, 0}, 40000);
   CHECK(got.r == doctest::Approx(rho * kInvPi * E).epsilon(0.01));
+  // With one scattering vertex the light-sampled and BSDF-sampled halves of
+  // the MIS pair must both be counted (the BSDF ray leaving the last vertex
+  // is traced for emission): direct light alone is the whole answer here.
+  Rgb direct = meanRadiance(*s, {1.0f, 0.5f, 1.5f}, {0, 0, 0}, 40000, 3, 1);
+  MESSAGE("max depth 1: " << direct.r << ", expected " << rho * kInvPi * E);
+  CHECK(direct.r == doctest::Approx(rho * kInvPi * E).epsilon(0.01));
 }
 
 TEST_CASE("furnace: white objects under a uniform sky reflect exactly the sky") {

@@ -26,7 +26,12 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler) co
   bool lastDelta = true;  // the camera ray counts as "specular": no MIS on a direct hit
   float lastPdf = 0.0f;
   Vec3f lastP = origin;
-  for (int depth = 0; depth < maxDepth_; ++depth) {
+  // maxDepth_ vertices scatter (next-event estimation and a BSDF sample);
+  // the ray leaving the last one is still traced, for the emission and sky
+  // it finds: it is the BSDF half of that vertex's MIS pair, without which
+  // direct light from area lights would lose its BSDF-sampled share (all of
+  // it for max_depth 1). pbrt's maxdepth counts the same way.
+  for (int depth = 0;; ++depth) {
     Hit hit;
     if (!scene_.intersect(origin, dir, std::numeric_limits<float>::infinity(), time01, hit)) {
       L += beta * scene_.background;
@@ -43,6 +48,7 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler) co
       }
       break;  // emitters do not reflect
     }
+    if (depth == maxDepth_) break;
     const Material& mat = scene_.materials[scene_.objects[hit.object].material];
     ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
 
