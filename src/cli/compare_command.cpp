@@ -283,16 +283,20 @@ int runCompare(const CompareArgs& a) {
 
   ImageMetrics m = image::compareImages(test.color, ref.color, crop);
 
-  // Both profile files or neither (each is atomic on its own).
-  if (profile && a.csv) writeTextFileAtomic(*a.csv, image::profileCsv(*profile));
-  if (profile && a.plot) {
-    try {
-      writeTextFileAtomic(*a.plot, image::profileSvg(*profile, a.test, a.reference));
-    } catch (...) {
-      if (a.csv) std::remove(a.csv->c_str());
-      throw;
-    }
+  // Both profile files or neither, committed together: on any failure the
+  // previous pair (if any) stays as it was.
+  std::optional<AtomicFile> csvFile, plotFile;
+  if (profile && a.csv) {
+    csvFile.emplace(*a.csv);
+    writeTextToTemp(*csvFile, image::profileCsv(*profile));
   }
+  if (profile && a.plot) {
+    plotFile.emplace(*a.plot);
+    writeTextToTemp(*plotFile, image::profileSvg(*profile, a.test, a.reference));
+  }
+  if (csvFile && plotFile) commitTogether({&*csvFile, &*plotFile});
+  else if (csvFile) csvFile->commit();
+  else if (plotFile) plotFile->commit();
 
   if (m.nonFiniteTest || m.nonFiniteRef)
     std::fprintf(stderr, "tdpm: warning: %zu non-finite values in %s and %zu in %s were counted as 0\n",

@@ -248,6 +248,12 @@ bool sameFile(const std::string& a, const std::string& b) {
 
 void writeTextFileAtomic(const std::string& path, const std::string& contents) {
   AtomicFile file(path);
+  writeTextToTemp(file, contents);
+  file.commit();
+}
+
+void writeTextToTemp(const AtomicFile& file, const std::string& contents) {
+  const std::string& path = file.targetPath();
   std::FILE* f = std::fopen(file.tempPath().c_str(), "wb");
   if (!f) {
     int err = errno;
@@ -258,7 +264,6 @@ void writeTextFileAtomic(const std::string& path, const std::string& contents) {
   if (std::fclose(f) != 0 && writeErr == 0) writeErr = errno;
   if (written != contents.size() || writeErr != 0)
     throw Error(path + ": write failed: " + osReason(writeErr ? writeErr : EIO));
-  file.commit();
 }
 
 }  // namespace tdpm

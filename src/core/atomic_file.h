@@ -1,7 +1,7 @@
 // core/atomic_file.h — all-or-nothing output files.
 // Owns: AtomicFile (RAII temp file + rename), commitTogether (several files
 // renamed as one: all or none), checkOutputPath (the same checks before any
-// work) and writeTextFileAtomic.
+// work), writeTextFileAtomic and writeTextToTemp.
 // Why: a render that fails or is interrupted half-way must never leave a
 // truncated EXR/PNG/CSV under the name the user asked for (a later `compare`
 // would read it as a real result), nor an EXR that does not belong to its
@@ -77,5 +77,8 @@ bool sameFile(const std::string& a, const std::string& b);
 
 // Writes `contents` to `path` atomically (CSV, JSON, SVG outputs).
 void writeTextFileAtomic(const std::string& path, const std::string& contents);
+// Writes `contents` into `file`'s temporary (not committed), for outputs
+// that are committed together (commitTogether).
+void writeTextToTemp(const AtomicFile& file, const std::string& contents);
 
 }  // namespace tdpm
