@@ -3,7 +3,12 @@
 // against plain emission for every light type, time stratification.
 #include <doctest/doctest.h>
 
+#include <tbb/global_control.h>
+
+#include <algorithm>
 #include <cmath>
+#include <memory>
+#include <vector>
 
 #include "photon/tracer.h"
 #include "scene_fixtures.h"
@@ -82,23 +87,25 @@ TEST_CASE("photon tracing: projection maps keep the caustic energy and waste few
   // Paths saved at least this many times over: a 40-degree spot already
   // aims most of its power at the ball, the others waste most paths.
   const int minGain[] = {5, 2, 20, 2};
-  for (int i = 0; i < 4; ++i) {
-    auto d = glassOverFloor({lights[size_t(i)]});
+  for (int i = 0; i < 8; ++i) {
+    if (i == 6) continue;  // sobol: the directional light's plain emission alone takes seconds
+    auto d = glassOverFloor({lights[size_t(i % 4)]});
     auto s = Scene::build(d);
     photon::TraceSettings ts;
     ts.kind = photon::MapKind::Caustic;
     ts.storedWanted = 40000;
     ts.seed = 17;
+    ts.sampler = i < 4 ? SamplerKind::Random : SamplerKind::Sobol;  // both kinds keep the energy
     photon::TraceResult with = photon::tracePhotons(*s, ts, Progress{});
     ts.projection = false;
     photon::TraceResult without = photon::tracePhotons(*s, ts, Progress{});
     double a = totalEnergy(with.store), b = totalEnergy(without.store);
-    INFO(names[i] << ": with projection " << a << " J from " << with.emitted << " paths, without " << b << " J from "
+    INFO(names[i % 4] << " (" << samplerName(ts.sampler) << "): with projection " << a << " J from " << with.emitted << " paths, without " << b << " J from "
                   << without.emitted);
     REQUIRE(b > 0);
     // Each total sums ~40k photons: a few per mille of noise; 3% bounds it.
     CHECK(a == doctest::Approx(b).epsilon(0.03));
-    CHECK(with.emitted * uint64_t(minGain[i]) < without.emitted);
+    CHECK(with.emitted * uint64_t(minGain[i % 4]) < without.emitted);
   }
 }
 
@@ -258,4 +265,87 @@ TEST_CASE("photon tracing: a narrow spot is emitted through its own cone, not th
   ts.kind = photon::MapKind::Caustic;
   ts.storedWanted = 1000;
   CHECK(photon::tracePhotons(*s, ts, Progress{}).store.size() == 0);
+}
+
+namespace {
+
+// A point light at the centre of a diffuse sphere: every emitted path stores
+// one photon at its emission direction times the radius.
+std::unique_ptr<Scene> pointInSphere() {
+  auto d = test::emptyScene(8, 8);
+  d.camera.shutterClose = 2.0f;
+  d.materials.push_back(test::diffuse(Rgb(0.5f)));
+  d.objects.push_back(test::sphere(10.0f, {0, 0, 0}, 0));
+  scene::LightDesc l;
+  l.type = scene::LightDesc::Type::Point;
+  l.position = {0, 0, 0};
+  l.power = Rgb(100.0f);
+  d.lights.push_back(l);
+  return Scene::build(d);
+}
+
+photon::TraceResult firstHits(const Scene& s, SamplerKind kind, size_t wanted) {
+  photon::TraceSettings ts;
+  ts.kind = photon::MapKind::Global;
+  ts.storedWanted = wanted;
+  ts.maxBounces = 0;
+  ts.seed = 7;
+  ts.sampler = kind;
+  return photon::tracePhotons(s, ts, Progress{});
+}
+
+// Chi-square of the photons' directions over 8 x 16 equal-solid-angle bins
+// (cos theta in 8 equal slices, phi in 16).
+double directionChiSquare(const photon::PhotonStore& st) {
+  std::vector<double> bins(128, 0.0);
+  for (size_t i = 0; i < st.size(); ++i) {
+    Vec3f d = normalize(st.position(i));
+    int zb = std::min(7, std::max(0, int((d.z + 1.0f) * 0.5f * 8.0f)));
+    float phi = std::atan2(d.y, d.x) + float(M_PI);
+    int pb = std::min(15, std::max(0, int(phi / float(2.0 * M_PI) * 16.0f)));
+    bins[size_t(zb * 16 + pb)] += 1.0;
+  }
+  double expected = double(st.size()) / 128.0, chi = 0;
+  for (double b : bins) chi += (b - expected) * (b - expected) / expected;
+  return chi;
+}
+
+}  // namespace
+
+TEST_CASE("photon tracing: sobol emission directions are better stratified than random, same energies") {
+  auto s = pointInSphere();
+  photon::TraceResult rnd = firstHits(*s, SamplerKind::Random, 16384);
+  photon::TraceResult sob = firstHits(*s, SamplerKind::Sobol, 16384);
+  REQUIRE(rnd.store.size() > 10000);
+  REQUIRE(sob.store.size() > 10000);
+  double chiR = directionChiSquare(rnd.store), chiS = directionChiSquare(sob.store);
+  MESSAGE("chi-square over 128 bins: random " << chiR << ", sobol " << chiS);
+  // Random: chi-square with 127 degrees of freedom (mean 127, sd ~16).
+  CHECK(chiR > 70);
+  CHECK(chiS < 0.25 * chiR);
+  // The whole power reaches the sphere: 100 W * 2 s, exactly in expectation.
+  CHECK(totalEnergy(rnd.store) == doctest::Approx(200.0).epsilon(0.01));
+  CHECK(totalEnergy(sob.store) == doctest::Approx(200.0).epsilon(0.01));
+}
+
+TEST_CASE("photon tracing: a sobol map is identical for 1 and 2 threads") {
+  auto s = pointInSphere();
+  photon::TraceResult one, two;
+  {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+    one = firstHits(*s, SamplerKind::Sobol, 8000);
+  }
+  {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+    two = firstHits(*s, SamplerKind::Sobol, 8000);
+  }
+  REQUIRE(one.store.size() == two.store.size());
+  REQUIRE(one.store.size() > 0);
+  bool same = true;
+  for (size_t i = 0; i < one.store.size(); ++i) {
+    Vec3f a = one.store.position(i), b = two.store.position(i);
+    same = same && a.x == b.x && a.y == b.y && a.z == b.z && one.store.time(i) == two.store.time(i);
+  }
+  CHECK(same);
+  CHECK(one.emitted == two.emitted);
 }

@@ -168,9 +168,10 @@ float sampleTowardTargets(const std::vector<Target>& targets, Vec3f x, const Emi
 
 // Caustic-map emission of one light toward the targets. flux = emitted
 // radiometric quantity / density, as in emitFromLight.
+template <class Stream>
 bool emitTowardTargets(const Light& light, const std::vector<Target>& targets, float time01, const Bounds3f& bounds,
-                       Rng& rng, EmittedRay& out) {
-  Vec3f uvw{rng.uniform(), rng.uniform(), rng.uniform()};
+                       Stream& rng, EmittedRay& out) {
+  Vec3f uvw = rng.get3D(dims::kPhotonDirection);
   switch (light.type) {
     case Light::Type::Point:
     case Light::Type::Spot: {
@@ -193,7 +194,10 @@ bool emitTowardTargets(const Light& light, const std::vector<Target>& targets, f
     case Light::Type::Area: {
       AreaLightFrame fr = areaLightFrame(light, time01);
       if (!(fr.area > 0)) return false;
-      Vec3f q = fr.center + fr.edgeX * (rng.uniform() - 0.5f) + fr.edgeZ * (rng.uniform() - 0.5f);
+      // x and y crossed: the old expression drew its two rng.uniform()
+      // calls right to left (GCC's order), and random keeps its maps.
+      Vec2f uPos = rng.get2D(dims::kPhotonPosition);
+      Vec3f q = fr.center + fr.edgeX * (uPos.y - 0.5f) + fr.edgeZ * (uPos.x - 0.5f);
       float pdf = sampleTowardTargets(targets, q, EmitterCone{}, uvw, out.direction);
       float cosT = dot(out.direction, fr.normal);
       if (!(pdf > 0) || cosT <= 0) return false;
@@ -314,24 +318,38 @@ struct Tracer {
   // Returns the number of rays cast.
   uint64_t traceBatch(uint64_t b, double energyScale, PhotonStore& out) const {
     Rng rng(hashCombine(settings.seed, uint64_t(settings.kind) + 1, b), 0x9e37);
+    // sobol: the path index is the sample index, the map's seed and kind the "pixel".
+    uint64_t sobolSeed = hashCombine(settings.seed, uint64_t(settings.kind) + 1, 0x9407ull);
     uint64_t rays = 0;
     for (uint32_t i = 0; i < kPathsPerBatch; ++i) {
       uint64_t g = b * kPathsPerBatch + i;
+      // The time stays the scrambled van der Corput of the path index for
+      // both kinds: it is already a stratified 1D sequence over the shutter.
       float time01 = settings.spreadInTime ? scrambledVanDerCorput(uint32_t(g), timeScramble) : settings.fixedTime01;
-      rays += tracePath(time01, rng, energyScale, out);
+      if (settings.sampler == SamplerKind::Sobol) {
+        SobolStream s{sobolSeed, uint32_t(g)};
+        rays += tracePath(time01, s, energyScale, out);
+      } else {
+        RandomStream s{&rng};
+        rays += tracePath(time01, s, energyScale, out);
+      }
     }
     return rays;
   }
 
-  uint64_t tracePath(float time01, Rng& rng, double energyScale, PhotonStore& out) const {
+  // Draws follow sampling/sampler.h's photon groups; RandomStream ignores
+  // the group and draws in call order, which is the old PCG32 order.
+  template <class Stream>
+  uint64_t tracePath(float time01, Stream& rng, double energyScale, PhotonStore& out) const {
     uint64_t rays = 0;
-    uint32_t li = lights.pick(rng.uniform());
+    uint32_t li = lights.pick(rng.get1D(dims::kPhotonLight));
     const Light& light = scene.lights[li];
     EmittedRay ray;
     if (settings.kind == MapKind::Caustic && settings.projection) {
       if (!emitTowardTargets(light, targets, time01, scene.bounds, rng, ray)) return rays;
     } else {
-      Vec2f uPos{rng.uniform(), rng.uniform()}, uDir{rng.uniform(), rng.uniform()};
+      Vec2f uPos = rng.get2D(dims::kPhotonPosition);
+      Vec2f uDir = rng.get2D(dims::kPhotonDirection);
       if (!emitFromLight(light, time01, scene.bounds, uPos, uDir, ray)) return rays;
     }
     Rgb power = ray.flux / lights.pdf[li];
@@ -355,14 +373,14 @@ struct Tracer {
       }
       ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
       BsdfSample bs;
-      Vec2f u{rng.uniform(), rng.uniform()};
-      if (!bsdfSample(ctx, u, rng.uniform(), Transport::Importance, bs)) return rays;
+      Vec3f ub = rng.get3D(dims::vertexGroup(bounce, dims::kBsdf));
+      if (!bsdfSample(ctx, {ub.x, ub.y}, ub.z, Transport::Importance, bs)) return rays;
       if (settings.kind == MapKind::Caustic && !bs.delta) return rays;
       allSpecular = allSpecular && bs.delta;
       // Russian roulette by the scattering's throughput: surviving photons
       // keep (on average) their power instead of dimming.
       float survive = std::min(1.0f, bs.weight.maxComponent());
-      if (!(survive > 0) || rng.uniform() >= survive) return rays;
+      if (!(survive > 0) || rng.get1D(dims::vertexGroup(bounce, dims::kRoulette)) >= survive) return rays;
       power = power * bs.weight / survive;
       origin = scene.spawnOrigin(hit.p, hit.n, bs.wi);
       dir = bs.wi;

@@ -14,6 +14,7 @@
 
 #include "core/progress.h"
 #include "photon/store.h"
+#include "sampling/sampler.h"
 #include "scene/scene.h"
 
 namespace tdpm::photon {
@@ -31,6 +32,10 @@ struct TraceSettings {
   // spheres (projection maps). Same expected energies, far fewer wasted
   // paths; off only to measure that.
   bool projection = true;
+  // Where a path's emission, bounce and roulette numbers come from
+  // (docs/sampling.md): random = one PCG32 per batch (the maps of old),
+  // sobol = Owen-scrambled Sobol indexed by the global path index.
+  SamplerKind sampler = SamplerKind::Random;
 };
 
 struct TraceResult {

@@ -216,6 +216,7 @@ Maps tracePhotonMaps(const Scene& scene, const RenderOptions& opt, size_t causti
   ms.trace.maxBounces = opt.maxDepth;
   ms.trace.spreadInTime = spreadInTime;
   ms.trace.fixedTime01 = fixedTime01;
+  ms.trace.sampler = opt.sampler;
   ms.trace.kind = photon::MapKind::Caustic;
   ms.trace.storedWanted = causticWanted;
   maps.caustic = buildPhotonMap(scene, ms, progress);

@@ -24,7 +24,8 @@
 //     kGather        2D  final-gather direction (sub = gather ray index)
 //   photon path (sample index = path index, "pixel" = the map's seed):
 //     kPhotonLight 1D light choice, kPhotonPosition 2D, kPhotonDirection 2D,
-//     kPhotonTime 1D, then vertexGroup(bounce, kBsdf / kRoulette).
+//     kPhotonTime 1D (reserved: times stay scrambled van der Corput), then
+//     vertexGroup(bounce, kBsdf / kRoulette); photon/tracer.cpp.
 //
 // The sample index of a pixel runs 0, 1, 2, ... across adaptive batches
 // (and a later pass loop can continue it: startSample() takes any index),
