@@ -398,7 +398,9 @@ struct Tracer {
     all.reserve(expected);
     std::atomic<uint64_t> rays{0};
     std::atomic<size_t> done{0};
-    progress(stage, 0, size_t(batches));
+    // Counted in photon paths emitted (the bar's unit for "... photons" stages).
+    const size_t paths = size_t(batches) * kPathsPerBatch;
+    progress(stage, 0, paths);
     std::vector<PhotonStore> parts;
     for (uint64_t first = 0; first < batches; first += kBatchesPerChunk) {
       size_t count = size_t(std::min<uint64_t>(kBatchesPerChunk, batches - first));
@@ -406,7 +408,7 @@ struct Tracer {
       tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t b = r.begin(); b != r.end(); ++b) {
           rays += traceBatch(first + b, energyScale, parts[b]);
-          progress(stage, done.fetch_add(1) + 1, size_t(batches));
+          progress(stage, (done.fetch_add(1) + 1) * kPathsPerBatch, paths);
         }
       });
       all.appendBatches(parts);

@@ -4,13 +4,22 @@
 // a per-thread scratch object it may reuse (no allocation per sample, no
 // locks). Progress is reported once per finished tile. Results must depend
 // only on the pixel (seeded per pixel), so they are identical for any
-// thread count.
+// thread count and any tile order.
+//
+// Tiles are handed out scattered over the image, not row by row: tile
+// number i is (i * stride) mod total with stride near 0.618 total and
+// coprime to it (a permutation: a Weyl sequence). The tiles finished at
+// any moment are then a fair sample of the image, so the progress bar's
+// time left, measured from them, holds; in row order the cheap sky came
+// first and the bar said "0:04 left" at 25% of a 29 s render
+// (scenes/glass-ball.json, cli/progress_bar.h).
 #pragma once
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <atomic>
+#include <cstdint>
 #include <string>
 
 #include "core/progress.h"
@@ -23,17 +32,31 @@ struct Tile {
 
 constexpr int kTileSize = 16;
 
+// The stride of the scattered tile order (see above): coprime to `total`.
+inline size_t tileOrderStride(size_t total) {
+  if (total <= 2) return 1;
+  size_t s = size_t(double(total) * 0.6180339887498949);
+  auto gcd = [](size_t a, size_t b) {
+    while (b) { size_t t = a % b; a = b; b = t; }
+    return a;
+  };
+  while (gcd(s, total) != 1) ++s;
+  return s;
+}
+
 template <class Scratch, class TileFn>
 void forEachTile(int width, int height, const std::string& stage, const Progress& progress, TileFn&& fn) {
   const int tilesX = (width + kTileSize - 1) / kTileSize;
   const int tilesY = (height + kTileSize - 1) / kTileSize;
   const size_t total = size_t(tilesX) * size_t(tilesY);
+  const size_t stride = tileOrderStride(total);
   std::atomic<size_t> done{0};
   tbb::enumerable_thread_specific<Scratch> scratch;
   progress(stage, 0, total);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, total, 1), [&](const tbb::blocked_range<size_t>& r) {
     Scratch& s = scratch.local();
-    for (size_t i = r.begin(); i != r.end(); ++i) {
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      const size_t i = size_t((uint64_t(k) * stride) % total);  // tiles <= 2^24: no overflow
       int tx = int(i % size_t(tilesX)), ty = int(i / size_t(tilesX));
       Tile t{tx * kTileSize, ty * kTileSize, std::min(width, (tx + 1) * kTileSize), std::min(height, (ty + 1) * kTileSize)};
       fn(t, s);
