@@ -1,0 +1,139 @@
+// render/progressive_io.cpp — ProgressiveState <-> EXR channels and
+// attributes (layout in progressive_io.h).
+#include "render/progressive_io.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cctype>
+#include <cstdint>
+#include <cstdlib>
+#include <set>
+
+#include "core/error.h"
+
+namespace tdpm {
+namespace {
+
+const std::string kAttr = kProgressiveAttributePrefix;
+const std::string kLayer = kProgressiveLayerPrefix;
+constexpr const char* kLayoutVersion = "1";
+
+bool startsWith(const std::string& s, const std::string& prefix) { return s.compare(0, prefix.size(), prefix) == 0; }
+
+std::string joinNames(const std::map<std::string, std::vector<float>>& layers) {
+  std::string s;
+  for (const auto& kv : layers) s += (s.empty() ? "" : ",") + kv.first;
+  return s;
+}
+
+std::vector<std::string> splitNames(const std::string& s) {
+  std::vector<std::string> out;
+  if (s.empty()) return out;
+  size_t start = 0;
+  for (;;) {
+    size_t comma = s.find(',', start);
+    out.push_back(s.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string exactDoubleText(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+bool parseExactDouble(const std::string& text, double& v) {
+  if (text.empty() || std::isspace(static_cast<unsigned char>(text[0]))) return false;
+  errno = 0;
+  char* end = nullptr;
+  double x = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0') return false;
+  // ERANGE on underflow still returns the right subnormal or zero; on
+  // overflow strtod gives +-HUGE_VAL for text that was not "inf": refused.
+  if (errno == ERANGE && std::isinf(x)) return false;
+  v = x;
+  return true;
+}
+
+void addProgressiveState(const ProgressiveState& state, image::ExrFile& exr) {
+  // Replace, never mix: drop an older state's channels and attributes first.
+  for (auto it = exr.metadata.begin(); it != exr.metadata.end();)
+    it = startsWith(it->first, kAttr) ? exr.metadata.erase(it) : std::next(it);
+  for (auto it = exr.extra.begin(); it != exr.extra.end();)
+    it = startsWith(it->name, kLayer) ? exr.extra.erase(it) : std::next(it);
+
+  const size_t pixels = exr.color.pixelCount();
+  for (const auto& [name, values] : state.layers) {
+    TDPM_ASSERT(!name.empty() && name.find(',') == std::string::npos, "progressive layer name '" + name + "'");
+    TDPM_ASSERT(values.size() == pixels, "progressive layer '" + name + "' does not have the image's pixel count");
+    exr.extra.push_back(image::Channel{kLayer + name, values});
+  }
+  exr.metadata[kAttr + "version"] = kLayoutVersion;
+  exr.metadata[kAttr + "passes"] = std::to_string(state.passesDone);
+  exr.metadata[kAttr + "fingerprint"] = state.fingerprint;
+  exr.metadata[kAttr + "layers"] = joinNames(state.layers);
+  for (const auto& [name, value] : state.settings) exr.metadata[kAttr + "setting/" + name] = value;
+  for (const auto& [name, value] : state.scalars) exr.metadata[kAttr + "scalar/" + name] = exactDoubleText(value);
+}
+
+std::optional<ProgressiveState> progressiveStateOf(const image::ExrFile& exr, const std::string& path) {
+  auto version = exr.metadata.find(kAttr + "version");
+  if (version == exr.metadata.end()) return std::nullopt;
+  auto bad = [&](const std::string& what) {
+    return Error(path + ": damaged progressive state: " + what + " (the file's " + kAttr + "* attributes and " +
+                 kLayer + "* layers)");
+  };
+  if (version->second != kLayoutVersion)
+    throw Error(path + ": progressive state of layout version '" + version->second + "', this tdpm reads version " +
+                kLayoutVersion);
+  auto need = [&](const std::string& key) -> const std::string& {
+    auto it = exr.metadata.find(kAttr + key);
+    if (it == exr.metadata.end()) throw bad("attribute " + kAttr + key + " is missing");
+    return it->second;
+  };
+
+  ProgressiveState state;
+  const std::string& passes = need("passes");
+  {
+    char* end = nullptr;
+    errno = 0;
+    long long n = std::strtoll(passes.c_str(), &end, 10);
+    if (passes.empty() || *end != '\0' || errno == ERANGE || n < 0 || n > INT32_MAX ||
+        !std::isdigit(static_cast<unsigned char>(passes[0])))
+      throw bad(kAttr + "passes is '" + passes + "', not a number of passes");
+    state.passesDone = int(n);
+  }
+  state.fingerprint = need("fingerprint");
+  for (const auto& [key, value] : exr.metadata) {
+    if (!startsWith(key, kAttr)) continue;
+    const std::string name = key.substr(kAttr.size());
+    if (startsWith(name, "setting/")) {
+      state.settings[name.substr(8)] = value;
+    } else if (startsWith(name, "scalar/")) {
+      double v = 0;
+      if (!parseExactDouble(value, v)) throw bad(key + " is '" + value + "', not a number");
+      state.scalars[name.substr(7)] = v;
+    }
+  }
+  std::set<std::string> listed;
+  for (const std::string& name : splitNames(need("layers"))) {
+    if (name.empty() || !listed.insert(name).second) throw bad(kAttr + "layers lists '" + name + "' badly");
+    const image::Channel* c = exr.findChannel(kLayer + name);
+    if (!c) throw bad("layer " + kLayer + name + " is missing");
+    state.layers[name] = c->values;
+  }
+  for (const image::Channel& c : exr.extra)
+    if (startsWith(c.name, kLayer) && !listed.count(c.name.substr(kLayer.size())))
+      throw bad("layer " + c.name + " is not listed in " + kAttr + "layers");
+  return state;
+}
+
+}  // namespace tdpm

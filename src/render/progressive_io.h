@@ -1,0 +1,49 @@
+// render/progressive_io.h — a ProgressiveState (render/progressive_state.h)
+// inside an EXR file (image/exr.h ExrFile), and back, exactly.
+// Here and not in image/: image/ depends only on core and math, and the
+// state is the renderer's; this file is the one place that knows how the
+// state is laid out in the file (docs/progressive.md "What the EXR holds").
+//
+// Layout (written next to the image's own R, G, B, "spp", "variance.*"):
+//  * every state layer L as a FLOAT channel "progressive.L" (floats are
+//    stored as they are: bit-exact, NaN payloads and -0 included);
+//  * string attributes under "tdpm/progressive/":
+//      version      "1" (the layout; a reader refuses another)
+//      passes       passes done, decimal
+//      fingerprint  the render's fingerprint (render/fingerprint.h)
+//      layers       the layer names, comma-separated (so a missing one is an error)
+//      setting/NAME the fingerprinted options, as text
+//      scalar/NAME  the exact scalars, as "%.17g" (reads back to the same double)
+#pragma once
+#include <optional>
+#include <string>
+
+#include "image/exr.h"
+#include "render/progressive_state.h"
+
+namespace tdpm {
+
+// Prefixes of the state's attribute and channel names.
+inline constexpr const char* kProgressiveAttributePrefix = "tdpm/progressive/";
+inline constexpr const char* kProgressiveLayerPrefix = "progressive.";
+
+// Adds `state` to `exr` (channels and attributes as above), replacing any
+// state already there. Every layer must have exr.color's pixel count, and
+// layer names must be non-empty and free of commas: a bug otherwise
+// (TDPM_ASSERT).
+void addProgressiveState(const ProgressiveState& state, image::ExrFile& exr);
+
+// The state in `exr`, read from the file `path` (for messages); nullopt
+// when the file carries none (no "tdpm/progressive/version" attribute). A
+// state that is there but damaged (another layout version, an attribute
+// that does not parse, a listed layer missing) throws tdpm::Error
+// "<path>: ..." naming the attribute or layer.
+std::optional<ProgressiveState> progressiveStateOf(const image::ExrFile& exr, const std::string& path);
+
+// "%.17g": the shortest printf format that reads back (strtod) to the same
+// double for every finite value; "inf", "-inf" and "nan" for the others.
+std::string exactDoubleText(double v);
+// The inverse; false when `text` is not a whole number in that form.
+bool parseExactDouble(const std::string& text, double& v);
+
+}  // namespace tdpm
