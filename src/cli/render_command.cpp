@@ -257,6 +257,10 @@ void warnAccumulationPhotons(const RenderOptions& o, bool hasMotion, const Rende
 
 }  // namespace
 
+RenderOptions renderOptionsFor(const RenderArgs& a, const scene::SceneDescription& desc) {
+  return mergeOptions(a, desc.render, a.scene);
+}
+
 CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   CLI::App* c = app.add_subcommand("render", "Render a scene file to an OpenEXR image and a PNG preview");
   c->add_option("scene", a.scene, "Scene file: JSON (docs/scene-format.md) or pbrt-v3/v4 by the .pbrt extension (docs/pbrt-import.md)")->required();

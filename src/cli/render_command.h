@@ -8,6 +8,9 @@
 #include <optional>
 #include <string>
 
+#include "render/renderer.h"
+#include "scene/description.h"
+
 namespace tdpm::cli {
 
 struct RenderArgs {
@@ -32,6 +35,10 @@ struct RenderArgs {
 };
 
 CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args);
+// The render options of `args` over the scene's "render" block over the
+// defaults (what runRender renders with, before --resolution is applied to
+// the scene's camera). Throws tdpm::Error for contradictory settings.
+RenderOptions renderOptionsFor(const RenderArgs& args, const scene::SceneDescription& desc);
 int runRender(const RenderArgs& args);
 
 }  // namespace tdpm::cli

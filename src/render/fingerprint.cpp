@@ -1,0 +1,166 @@
+// render/fingerprint.cpp — scene digest, image-changing settings, and the
+// fingerprint made of them (render/fingerprint.h).
+#include "render/fingerprint.h"
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+
+#include "core/rng.h"
+#include "sampling/sampler.h"
+#include "scene/json_writer.h"
+
+namespace tdpm {
+namespace {
+
+// Two independent 64-bit FNV-1a streams, each finished by mix64: 128 bits,
+// stable across runs, builds and machines (std::hash is none of these).
+struct Hasher {
+  uint64_t a = 0xcbf29ce484222325ull, b = 0x84222325cbf29ce4ull;
+  void add(const void* data, size_t n) {
+    const unsigned char* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < n; ++i) {
+      a = (a ^ p[i]) * 0x100000001b3ull;
+      b = (b ^ p[i]) * 0x100000001b3ull;
+      b ^= b >> 29;
+    }
+  }
+  // Length first, so that ("ab", "c") and ("a", "bc") differ.
+  void add(const std::string& s) {
+    uint64_t n = s.size();
+    add(&n, sizeof n);
+    add(s.data(), s.size());
+  }
+  std::string hex() const {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%016llx%016llx", static_cast<unsigned long long>(mix64(a)),
+                  static_cast<unsigned long long>(mix64(b ^ 0x5bd1e995ull)));
+    return buf;
+  }
+};
+
+std::string floatText(float v) {
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", double(v));  // reads back to the same float
+  return buf;
+}
+
+const char* spaceKernelName(estimate::SpaceKernel k) {
+  switch (k) {
+    case estimate::SpaceKernel::Cone: return "cone";
+    case estimate::SpaceKernel::Epanechnikov: return "epanechnikov";
+    default: return "uniform";
+  }
+}
+
+const char* timeKernelName(estimate::TimeKernel k) {
+  return k == estimate::TimeKernel::Epanechnikov ? "epanechnikov" : "uniform";
+}
+
+}  // namespace
+
+std::map<std::string, std::string> renderSettings(const RenderOptions& o, int width, int height) {
+  const estimate::Options& e = o.estimate;
+  return {
+      {"method", o.method},
+      {"seed", std::to_string(o.seed)},
+      {"sampler", samplerName(o.sampler)},
+      {"spp", std::to_string(o.spp)},
+      {"max_spp", std::to_string(o.maxSpp)},
+      {"contrast", floatText(o.contrast)},
+      {"max_depth", std::to_string(o.maxDepth)},
+      {"photons", std::to_string(o.causticPhotons)},
+      {"global_photons", std::to_string(o.globalPhotons)},
+      {"frames", std::to_string(o.frames)},
+      {"search", o.spaceTime4D ? "4d" : "twopass"},
+      {"kappa", floatText(o.kappa)},
+      {"k", std::to_string(e.k)},
+      {"ks", std::to_string(e.ks)},
+      {"fraction", floatText(e.fraction)},
+      {"max_radius", std::isfinite(e.maxRadius) ? floatText(e.maxRadius) : "auto"},
+      {"max_dt", std::isfinite(e.maxTimeDistance) ? floatText(e.maxTimeDistance) : "auto"},
+      {"max_radius_fraction", floatText(o.maxRadiusFraction)},
+      {"max_dt_fraction", floatText(o.maxDtFraction)},
+      {"kernel_space", spaceKernelName(e.spaceKernel)},
+      {"kernel_time", timeKernelName(e.timeKernel)},
+      {"cone_k", floatText(e.coneK)},
+      {"min_radius2", floatText(e.minRadius2)},
+      {"gather", std::to_string(o.gatherRays)},
+      {"global_direct", o.visualizeGlobal ? "yes" : "no"},
+      {"resolution", std::to_string(width) + "x" + std::to_string(height)},
+  };
+}
+
+std::string sceneDigest(const scene::SceneDescription& d) {
+  Hasher h;
+  scene::SceneDescription c = d;
+  c.sourcePath.clear();
+  c.render = scene::RenderSettings{};  // the options, merged with the flags, are hashed as settings
+  c.camera.width = c.camera.height = 1;  // the resolution is a setting of its own
+  // Names the image does not depend on, and that the writer requires to be
+  // unique: by position instead.
+  for (size_t i = 0; i < c.materials.size(); ++i) c.materials[i].name = "m" + std::to_string(i);
+  for (scene::ObjectDesc& o : c.objects) {
+    scene::ShapeDesc& s = o.shape;
+    if (s.type != scene::ShapeDesc::Type::Mesh) continue;
+    // The triangles by their bytes (exact, and cheaper than OBJ text); the
+    // file they came from does not matter.
+    h.add("mesh " + o.name);
+    uint64_t nv = s.vertices.size(), ni = s.indices.size();
+    h.add(&nv, sizeof nv);
+    h.add(s.vertices.data(), s.vertices.size() * sizeof(Vec3f));
+    h.add(&ni, sizeof ni);
+    h.add(s.indices.data(), s.indices.size() * sizeof(uint32_t));
+    s.vertices.clear();
+    s.indices.clear();
+    s.meshFile.clear();
+  }
+  h.add(pbrt::sceneToJson(c, "scene.json").json);
+  return h.hex();
+}
+
+std::string fingerprintOfSettings(const std::map<std::string, std::string>& settings) {
+  Hasher h;
+  h.add("tdpm fingerprint 1");
+  for (const auto& [name, value] : settings) {
+    h.add(name);
+    h.add(value);
+  }
+  return h.hex();
+}
+
+RenderFingerprint fingerprintOf(const scene::SceneDescription& scene, const RenderOptions& options) {
+  RenderFingerprint f;
+  f.settings = renderSettings(options, scene.camera.width, scene.camera.height);
+  f.settings[kSceneSettingKey] = sceneDigest(scene);
+  f.value = fingerprintOfSettings(f.settings);
+  return f;
+}
+
+std::vector<std::string> settingDifferences(const std::map<std::string, std::string>& before,
+                                            const std::map<std::string, std::string>& now, const std::string& file) {
+  std::vector<std::string> out;
+  auto valueIn = [](const std::map<std::string, std::string>& m, const std::string& key) -> const std::string* {
+    auto it = m.find(key);
+    return it == m.end() ? nullptr : &it->second;
+  };
+  std::map<std::string, bool> keys;
+  for (const auto& kv : before) keys[kv.first] = true;
+  for (const auto& kv : now) keys[kv.first] = true;
+  // The scene first: when it differs, that is the news.
+  const std::string* sb = valueIn(before, kSceneSettingKey);
+  const std::string* sn = valueIn(now, kSceneSettingKey);
+  if (!sb || !sn || *sb != *sn) out.push_back("the scene differs");
+  for (const auto& kv : keys) {
+    const std::string& key = kv.first;
+    if (key == kSceneSettingKey) continue;
+    const std::string* b = valueIn(before, key);
+    const std::string* n = valueIn(now, key);
+    if (b && n && *b == *n) continue;
+    out.push_back(key + ": " + (b ? *b + " in " + file : "not set in " + file) + ", " + (n ? *n + " now" : "not set now"));
+  }
+  return out;
+}
+
+}  // namespace tdpm
