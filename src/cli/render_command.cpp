@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "cli/progress_bar.h"
+#include "cli/resume.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/memory.h"
@@ -285,6 +286,11 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_option("--resolution", a.resolution, "Image size WxH (overrides the scene), e.g. 640x480");
   c->add_option("--exposure", a.exposure, "PNG preview exposure in stops (the EXR is unaffected)")
       ->check(rangeOf(limits::kExposure));
+  c->add_option("--resume", a.resume,
+                 "Continue the progressive render that wrote this EXR (needs --progressive): its passes, kept in the "
+                 "file, are the start, and the new passes are averaged in. The scene and every setting that changes "
+                 "the image must be the same (an error names what differs); --threads, --passes, --time-limit and "
+                 "--exposure may change. --output may name the same file: it is replaced atomically (docs/resume.md)");
   c->add_option("-t,--threads", a.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
   c->add_flag("-q,--quiet", a.quiet, "No progress bar and no summary");
   c->add_flag("--stats", a.stats,
@@ -328,6 +334,10 @@ int runRender(const RenderArgs& a) {
   std::string output = a.output.empty() ? stemOf(a.scene) + ".exr" : a.output;
   if (a.method && !isRenderMethod(*a.method))
     throw Error("--method: unknown method '" + *a.method + "' (expected " + methodList() + ")");
+  // The --progressive flag of issue 10 enables this (and --resume): at merge,
+  // `= a.progressive`.
+  const bool progressive = false;
+  checkResumeFlags(a.resume ? &*a.resume : nullptr, progressive);
   int width = 0, height = 0;
   if (a.resolution) parseResolution(*a.resolution, width, height);
   std::string preview = image::previewPathFor(output);
@@ -370,6 +380,13 @@ int runRender(const RenderArgs& a) {
   } else {
     opt.resolutionSource = "camera.resolution in " + a.scene;
   }
+
+  // A progressive render starts from the state --resume names (checked
+  // against this scene and these options before any work) or from an empty
+  // one with this render's fingerprint (cli/resume.h); the pass loop
+  // updates it and the output EXR carries it (docs/resume.md).
+  ProgressiveState progressiveState;
+  if (progressive) progressiveState = initialProgressiveState(a.resume ? &*a.resume : nullptr, desc, opt);
 
   ThreadLimit limit(a.threads);
   ProgressBar bar(ProgressBar::shouldShow(a.quiet));

@@ -29,6 +29,8 @@ struct RenderArgs {
   std::optional<std::string> sampler;
   std::optional<float> fraction, kappa, maxRadius, maxDt;
   bool globalDirect = false;
+  // --resume: the EXR of an earlier progressive render to continue (cli/resume.h).
+  std::optional<std::string> resume;
   int threads = 0;  // 0: all cores
   bool quiet = false;
   bool stats = false;  // --stats: memory, photon and timing figures after the summary
