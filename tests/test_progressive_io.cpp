@@ -193,3 +193,21 @@ TEST_CASE("progressive io: no state, and damaged states") {
   expectError([](image::ExrFile& e) { e.extra.push_back(image::Channel{"progressive.extra", std::vector<float>(4)}); },
               "layer progressive.extra is not listed");
 }
+
+TEST_CASE("progressive io: adding a moved state gives the same file content") {
+  const ProgressiveState s = sampleState(3, 2);
+  const image::ExrFile copied = exrWith(s, 3, 2);
+  ProgressiveState moved = s;
+  image::ExrFile exr;
+  exr.color = image::ImageRgb(3, 2);
+  addProgressiveState(std::move(moved), exr);
+  CHECK(moved.layers.empty());
+  CHECK(exr.metadata.at("tdpm/progressive/layers") == "radius,spp,sum.B,sum.G,sum.R");
+  std::optional<ProgressiveState> a = progressiveStateOf(copied, "a.exr"), b = progressiveStateOf(exr, "b.exr");
+  REQUIRE(a);
+  REQUIRE(b);
+  CHECK(a->passesDone == b->passesDone);
+  CHECK(a->settings == b->settings);
+  for (const auto& [name, v] : a->layers)
+    CHECK(std::memcmp(b->layers.at(name).data(), v.data(), v.size() * sizeof(float)) == 0);
+}

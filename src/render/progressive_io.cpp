@@ -64,6 +64,11 @@ bool parseExactDouble(const std::string& text, double& v) {
 }
 
 void addProgressiveState(const ProgressiveState& state, image::ExrFile& exr) {
+  ProgressiveState copy = state;
+  addProgressiveState(std::move(copy), exr);
+}
+
+void addProgressiveState(ProgressiveState&& state, image::ExrFile& exr) {
   // Replace, never mix: drop an older state's channels and attributes first.
   for (auto it = exr.metadata.begin(); it != exr.metadata.end();)
     it = startsWith(it->first, kAttr) ? exr.metadata.erase(it) : std::next(it);
@@ -71,15 +76,16 @@ void addProgressiveState(const ProgressiveState& state, image::ExrFile& exr) {
     it = startsWith(it->name, kLayer) ? exr.extra.erase(it) : std::next(it);
 
   const size_t pixels = exr.color.pixelCount();
-  for (const auto& [name, values] : state.layers) {
+  exr.metadata[kAttr + "layers"] = joinNames(state.layers);
+  for (auto& [name, values] : state.layers) {
     TDPM_ASSERT(!name.empty() && name.find(',') == std::string::npos, "progressive layer name '" + name + "'");
     TDPM_ASSERT(values.size() == pixels, "progressive layer '" + name + "' does not have the image's pixel count");
-    exr.extra.push_back(image::Channel{kLayer + name, values});
+    exr.extra.push_back(image::Channel{kLayer + name, std::move(values)});
   }
+  state.layers.clear();
   exr.metadata[kAttr + "version"] = kLayoutVersion;
   exr.metadata[kAttr + "passes"] = std::to_string(state.passesDone);
   exr.metadata[kAttr + "fingerprint"] = state.fingerprint;
-  exr.metadata[kAttr + "layers"] = joinNames(state.layers);
   for (const auto& [name, value] : state.settings) exr.metadata[kAttr + "setting/" + name] = value;
   for (const auto& [name, value] : state.scalars) exr.metadata[kAttr + "scalar/" + name] = exactDoubleText(value);
 }

@@ -32,6 +32,10 @@ inline constexpr const char* kProgressiveLayerPrefix = "progressive.";
 // layer names must be non-empty and free of commas: a bug otherwise
 // (TDPM_ASSERT).
 void addProgressiveState(const ProgressiveState& state, image::ExrFile& exr);
+// The same, moving the layers into `exr` instead of copying them (the
+// write path of a large render holds no second copy); `state` keeps its
+// scalars, settings and fingerprint, its layers are left empty.
+void addProgressiveState(ProgressiveState&& state, image::ExrFile& exr);
 
 // The state in `exr`, read from the file `path` (for messages); nullopt
 // when the file carries none (no "tdpm/progressive/version" attribute). A
