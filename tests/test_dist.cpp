@@ -111,3 +111,26 @@ TEST_CASE("dist: a launcher is recognised from its environment, a plain run is n
   unsetenv("PMI_RANK");
   for (auto& kv : saved) setenv(kv.first.c_str(), kv.second.c_str(), 1);
 }
+
+TEST_CASE("dist: a round of units is combined on rank 0 in unit order (one process: its own unit)") {
+  dist::Comm& one = dist::local();
+  std::vector<float> sum(3, 0.0f);
+  int calls = 0;
+  auto add = [&](const float* v, size_t n) {
+    ++calls;
+    REQUIRE(n == sum.size());
+    for (size_t i = 0; i < n; ++i) sum[i] += v[i];
+  };
+  dist::combineRoundOnRoot(one, std::vector<float>{1.0f, 2.0f, 3.0f}, true, add);
+  dist::combineRoundOnRoot(one, std::vector<float>{0.5f, 0.25f, 0.125f}, true, add);
+  dist::combineRoundOnRoot(one, std::vector<float>{9.0f, 9.0f, 9.0f}, false, add);  // no unit: not added
+  CHECK(calls == 2);
+  CHECK(sum == std::vector<float>{1.5f, 2.25f, 3.125f});
+  // Units dealt round-robin: rank r of N owns r, r + N, ...
+  for (uint64_t u = 0; u < 20; ++u) {
+    int owners = 0;
+    for (int r = 0; r < 3; ++r) owners += dist::ownsUnit(u, r, 3);
+    CHECK(owners == 1);
+    CHECK(dist::ownsUnit(u, int(u % 3), 3));
+  }
+}

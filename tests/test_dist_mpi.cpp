@@ -76,6 +76,20 @@ void checkSameImage(const std::string& method, const std::string& extra) {
 
 }  // namespace
 
+TEST_CASE("mpi: the collectives of dist::Comm on 3 ranks (tests/mpi/dist_selftest.cpp)") {
+  std::string cmd = "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 '" + std::string(TDPM_MPIEXEC) +
+                    "' --oversubscribe -np 3 '" + TDPM_DIST_SELFTEST + "' 2>&1 < /dev/null";
+  std::string out;
+  FILE* p = popen(cmd.c_str(), "r");
+  REQUIRE(p);
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  int status = pclose(p);
+  CHECK_MESSAGE((WIFEXITED(status) && WEXITSTATUS(status) == 0), out);
+  CHECK_MESSAGE(out.find("dist_selftest: every check passed on 3 ranks") != std::string::npos, out);
+}
+
 TEST_CASE("mpi: 2 ranks render the time method bit-identical to one process (adaptive passes included)") {
   checkSameImage("time", "");
 }

@@ -88,6 +88,29 @@ inline void blockRange(uint64_t total, int rank, int size, uint64_t& lo, uint64_
 // k size .. k size + size - 1, one per rank, in rank order.
 inline bool ownsUnit(uint64_t unit, int rank, int size) { return unit % uint64_t(size) == uint64_t(rank); }
 
+// One round of an outer loop whose units are combined in order on rank 0
+// (progressive passes: pass k size + r ran on rank r; docs/distributed.md).
+// Every rank passes its unit's values (`hasUnit` false for a rank with no
+// unit this round, e.g. past the last pass); rank 0 calls add(values,
+// count) for each rank that had one, in rank order, which is unit order: the
+// same additions in the same order as one process, so bit-identical.
+// `mine` must have the same length on every rank that has a unit.
+template <class T, class AddUnit>
+void combineRoundOnRoot(Comm& comm, const std::vector<T>& mine, bool hasUnit, AddUnit&& add) {
+  std::vector<uint64_t> has = comm.allgather(hasUnit ? uint64_t(mine.size()) : 0);
+  std::vector<uint64_t> bytes(has.size());
+  uint64_t total = 0;
+  for (size_t r = 0; r < has.size(); ++r) total += (bytes[r] = has[r] * sizeof(T));
+  std::vector<T> all(comm.root() ? size_t(total / sizeof(T)) : 0);
+  comm.gathervToRoot(mine.data(), all.data(), bytes);
+  if (!comm.root()) return;
+  size_t offset = 0;
+  for (size_t r = 0; r < has.size(); ++r) {
+    if (has[r] > 0) add(all.data() + offset, size_t(has[r]));
+    offset += size_t(has[r]);
+  }
+}
+
 // The Comm of this process: the MPI world under mpirun (after a Session
 // started MPI), otherwise one process.
 Comm& world();
