@@ -55,18 +55,18 @@ bool sameBits(const image::ExrFile& a, const image::ExrFile& b) {
   return true;
 }
 
-void checkSameImage(const std::string& method, const std::string& extra) {
+void checkSameImage(const std::string& method, const std::string& extra, int ranks = 2) {
   std::string dir = test::makeTempDir();
   std::string args = "render '" + std::string(TDPM_SOURCE_DIR) + "/scenes/cube-caustic.json' -m " + method +
                      " --resolution 48x32 --spp 4 --max-spp 68 --contrast 0.2 --photons 6000 --global-photons 2000"
                      " -q " + extra;
   CommandResult one = test::runTdpm(args + " --seed 7 -t 2 -o " + dir + "/one.exr");
   REQUIRE_MESSAGE(one.exitCode == 0, one.output);
-  CommandResult two = runMpi(2, "", args + " --seed 7 -t 1 -o " + dir + "/two.exr");
+  CommandResult two = runMpi(ranks, "", args + " --seed 7 -t 1 -o " + dir + "/two.exr");
   REQUIRE_MESSAGE(two.exitCode == 0, two.output);
   image::ExrFile a = image::readExr(dir + "/one.exr"), b = image::readExr(dir + "/two.exr");
   CHECK(b.metadata["tdpm/method"] == method);
-  CHECK_MESSAGE(sameBits(a, b), method << ": 2 ranks differ from one process");
+  CHECK_MESSAGE(sameBits(a, b), method << ": " << ranks << " ranks differ from one process");
   // The comparison can fail: another seed gives another image.
   CommandResult other = test::runTdpm(args + " --seed 8 -t 2 -o " + dir + "/other.exr");
   REQUIRE(other.exitCode == 0);
@@ -92,6 +92,10 @@ TEST_CASE("mpi: the collectives of dist::Comm on 3 ranks (tests/mpi/dist_selftes
 
 TEST_CASE("mpi: 2 ranks render the time method bit-identical to one process (adaptive passes included)") {
   checkSameImage("time", "");
+}
+
+TEST_CASE("mpi: 3 ranks (uneven shares of batches and tiles) render the time method bit-identical to one process") {
+  checkSameImage("time", "--search 4d", 3);
 }
 
 TEST_CASE("mpi: 2 ranks render accumulation bit-identical to one process") {
