@@ -433,7 +433,11 @@ int runRender(const RenderArgs& a) {
   dist::raiseIfAnyFailed(comm, setupError);
 
   ThreadLimit limit(a.threads);
-  ProgressBar bar(comm.root() && ProgressBar::shouldShow(a.quiet));
+  // Under mpirun a rank's stderr is a pipe even on a terminal, but Open MPI
+  // gives its stdout a pty when mpirun's own output is a terminal: that
+  // decides for rank 0 (the bar still draws on stderr).
+  bool showBar = ProgressBar::shouldShow(a.quiet) || (comm.distributed() && !a.quiet && isatty(STDOUT_FILENO) == 1);
+  ProgressBar bar(comm.root() && showBar);
   if (comm.root())
     for (const std::string& w : accumulationSppWarnings(opt, scene->hasMotion))
       std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
