@@ -24,6 +24,7 @@ packages=(g++ cmake make pkg-config
   libtbb-dev libembree-dev libxsimd-dev libopenexr-dev libpng-dev
   doctest-dev nlohmann-json3-dev libtinyobjloader-dev libcli11-dev
   libnanoflann-dev libbenchmark-dev openimageio-tools
+  libopenmpi-dev openmpi-bin  # distributed rendering under mpirun (docs/distributed.md)
   clang libclang-rt-14-dev)  # libFuzzer + sanitizer runtimes (scripts/fuzz.sh); only recommended by clang
 
 missing=()

@@ -1,6 +1,7 @@
 // cli/render_command.cpp — the render subcommand.
 #include "cli/render_command.h"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -8,7 +9,9 @@
 #include <cmath>
 #include <cstring>
 #include <cstdio>
+#include <memory>
 #include <sstream>
+#include <vector>
 
 #include "cli/progress_bar.h"
 #include "cli/resume.h"
@@ -16,6 +19,7 @@
 #include "core/error.h"
 #include "core/memory.h"
 #include "core/timer.h"
+#include "dist/comm.h"
 #include "image/exr.h"
 #include "image/png.h"
 #include "import/pbrt_import.h"
@@ -158,6 +162,47 @@ void printStats(const RenderStats& st) {
   std::fprintf(stderr, "  samples per pixel: %d-%d\n", st.minSpp, st.maxSpp);
 }
 
+// One rank's share of a distributed render, for --stats.
+struct RankSeconds {
+  uint64_t bytesSent = 0;
+  double commSeconds = 0;     // in collectives, waiting for slower ranks included
+  double commCpuSeconds = 0;  // CPU of those (MPI busy-polls while waiting)
+  double renderSeconds = 0;
+  double cpuSeconds = 0;      // the process's user + system CPU so far
+};
+
+double processCpuSeconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  auto s = [](const timeval& t) { return double(t.tv_sec) + 1e-6 * double(t.tv_usec); };
+  return s(u.ru_utime) + s(u.ru_stime);
+}
+
+// Every rank's figures on rank 0 (one entry per rank; one process: itself).
+std::vector<RankSeconds> gatherRankStats(dist::Comm& comm, double renderSeconds) {
+  RankSeconds mine{comm.stats().bytesSent, comm.stats().seconds, comm.stats().cpuSeconds, renderSeconds,
+                   processCpuSeconds()};
+  std::vector<RankSeconds> all(size_t(comm.size()));
+  comm.gathervToRoot(&mine, all.data(), std::vector<uint64_t>(size_t(comm.size()), sizeof(RankSeconds)));
+  return all;
+}
+
+// --stats of a distributed render: one line per rank.
+void printRankStats(const std::vector<RankSeconds>& ranks) {
+  if (ranks.size() < 2) return;
+  std::fprintf(stderr, "  ranks: %zu (bytes sent counted once per receiving rank; communication time includes "
+                       "waiting for slower ranks)\n", ranks.size());
+  for (size_t r = 0; r < ranks.size(); ++r) {
+    const RankSeconds& k = ranks[r];
+    double share = k.renderSeconds > 0 ? 100.0 * k.commSeconds / k.renderSeconds : 0.0;
+    std::fprintf(stderr,
+                 "  rank %zu: %llu bytes sent (%s), %.3f s in communication of %.3f s rendering (%.1f%%); "
+                 "CPU %.3f s in all, %.3f s of it in communication\n",
+                 r, static_cast<unsigned long long>(k.bytesSent), formatMiB(k.bytesSent).c_str(), k.commSeconds,
+                 k.renderSeconds, share, k.cpuSeconds, k.commCpuSeconds);
+  }
+}
+
 std::string formatCount(uint64_t n) {
   char buf[32];
   if (n >= 1000000) std::snprintf(buf, sizeof buf, "%.1fM", double(n) / 1e6);
@@ -295,7 +340,8 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_flag("-q,--quiet", a.quiet, "No progress bar and no summary");
   c->add_flag("--stats", a.stats,
               "After the summary, print peak resident memory, bytes per photon, photons stored and emitted per map, "
-              "photon-pass and render seconds, estimate counts and samples per pixel (also with --quiet)");
+              "photon-pass and render seconds, estimate counts and samples per pixel (also with --quiet); under mpirun "
+              "also bytes sent and seconds spent in communication per rank");
   const std::string photonGroup = "Photon methods (static, accumulation, standard, time)";
   c->add_option("--photons", a.photons, "Caustic photons to store (default 200000)")
       ->check(rangeOf(limits::kPhotons))->group(photonGroup);
@@ -330,8 +376,20 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
 
 int runRender(const RenderArgs& a) {
   Timer total;
+  // Under mpirun every rank loads and checks everything itself; an error on
+  // any rank stops every rank before work starts, reported once
+  // (dist::raiseIfAnyFailed). Rank 0 alone checks and writes the outputs,
+  // prints progress, warnings and the summary.
+  dist::Comm& comm = dist::world();
   const bool pbrtScene = pbrt::isPbrtPath(a.scene);
   std::string output = a.output.empty() ? stemOf(a.scene) + ".exr" : a.output;
+  std::string preview = image::previewPathFor(output);
+  scene::SceneDescription desc;
+  RenderOptions opt;
+  float exposure = 0.0f;
+  std::unique_ptr<Scene> scene;
+  std::string setupError;
+  try {
   if (a.method && !isRenderMethod(*a.method))
     throw Error("--method: unknown method '" + *a.method + "' (expected " + methodList() + ")");
   // The --progressive flag of issue 10 enables this (and --resume): at merge,
@@ -340,23 +398,23 @@ int runRender(const RenderArgs& a) {
   checkResumeFlags(a.resume ? &*a.resume : nullptr, progressive);
   int width = 0, height = 0;
   if (a.resolution) parseResolution(*a.resolution, width, height);
-  std::string preview = image::previewPathFor(output);
   // A pbrt scene names its own output (Film "filename"), known only once it is read.
-  if (!pbrtScene || !a.output.empty()) validateOutput(output, preview, a.scene);
+  if (comm.root() && (!pbrtScene || !a.output.empty())) validateOutput(output, preview, a.scene);
 
-  scene::SceneDescription desc;
   if (pbrtScene) {
     pbrt::ImportResult imported = pbrt::importPbrtFile(a.scene);
-    for (const std::string& n : imported.notes) std::fprintf(stderr, "tdpm: note: %s\n", n.c_str());
+    if (comm.root())
+      for (const std::string& n : imported.notes) std::fprintf(stderr, "tdpm: note: %s\n", n.c_str());
     if (a.output.empty()) {
       if (imported.filmFilename) output = exrNameForFilm(*imported.filmFilename);
       preview = image::previewPathFor(output);
-      validateOutput(output, preview, a.scene);
+      if (comm.root()) validateOutput(output, preview, a.scene);
     }
     desc = std::move(imported.scene);
   } else {
     desc = scene::loadScene(a.scene);
   }
+  dist::testFailurePoint(comm, "load");
   if (a.kappa) {
     // The usable kappa depends on the scene's shutter (scene/limits.h).
     limits::KappaRange r = limits::kappaRange(double(desc.camera.shutterClose) - desc.camera.shutterOpen);
@@ -368,11 +426,12 @@ int runRender(const RenderArgs& a) {
                   "] (float range)");
     }
   }
-  for (const scene::ObjectDesc& o : desc.objects)
-    if (o.shape.type == scene::ShapeDesc::Type::Mesh)
-      refuseOverwritingInput(output, preview, o.shape.meshFile, "the mesh file of object '" + o.name + "'");
-  RenderOptions opt = mergeOptions(a, desc.render, a.scene);
-  float exposure = pick(a.exposure, desc.render.exposure, 0.0f);
+  if (comm.root())
+    for (const scene::ObjectDesc& o : desc.objects)
+      if (o.shape.type == scene::ShapeDesc::Type::Mesh)
+        refuseOverwritingInput(output, preview, o.shape.meshFile, "the mesh file of object '" + o.name + "'");
+  opt = mergeOptions(a, desc.render, a.scene);
+  exposure = pick(a.exposure, desc.render.exposure, 0.0f);
   if (a.resolution) {
     desc.camera.width = width;
     desc.camera.height = height;
@@ -380,6 +439,12 @@ int runRender(const RenderArgs& a) {
   } else {
     opt.resolutionSource = "camera.resolution in " + a.scene;
   }
+  scene = Scene::build(desc);
+  } catch (const Error& e) {
+    if (!comm.distributed()) throw;
+    setupError = e.what();
+  }
+  dist::raiseIfAnyFailed(comm, setupError);
 
   // A progressive render starts from the state --resume names (checked
   // against this scene and these options before any work) or from an empty
@@ -389,13 +454,20 @@ int runRender(const RenderArgs& a) {
   if (progressive) progressiveState = initialProgressiveState(a.resume ? &*a.resume : nullptr, desc, opt);
 
   ThreadLimit limit(a.threads);
-  ProgressBar bar(ProgressBar::shouldShow(a.quiet));
-  auto scene = Scene::build(desc);
-  for (const std::string& w : accumulationSppWarnings(opt, scene->hasMotion))
-    std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
+  // Under mpirun a rank's stderr is a pipe even on a terminal, but Open MPI
+  // gives its stdout a pty when mpirun's own output is a terminal: that
+  // decides for rank 0 (the bar still draws on stderr).
+  bool showBar = ProgressBar::shouldShow(a.quiet) || (comm.distributed() && !a.quiet && isatty(STDOUT_FILENO) == 1);
+  ProgressBar bar(comm.root() && showBar);
+  if (comm.root())
+    for (const std::string& w : accumulationSppWarnings(opt, scene->hasMotion))
+      std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
   RenderStats stats;
-  Film film = render(*scene, opt, bar.progress(), stats);
+  Film film = render(*scene, opt, bar.progress(), stats, comm);
   bar.finish();
+  // --stats: every rank's communication, gathered before rank 0 writes.
+  std::vector<RankSeconds> ranks = gatherRankStats(comm, stats.seconds);
+  if (!comm.root()) return 0;
   for (const std::string& w : stats.warnings) std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
   warnAccumulationPhotons(opt, scene->hasMotion, stats);
 
@@ -424,8 +496,9 @@ int runRender(const RenderArgs& a) {
   stats.peakResidentBytes = peakResidentBytes();      // --stats: the write path included
 
   if (!a.quiet) {
-    std::fprintf(stderr, "tdpm: %s, %s: %dx%d, %s camera samples (%d-%d per pixel), %.2f s in all -> %s (preview %s)\n",
-                 a.scene.c_str(), opt.method.c_str(), filmWidth, filmHeight,
+    std::string ranksNote = comm.distributed() ? " on " + std::to_string(comm.size()) + " ranks" : std::string();
+    std::fprintf(stderr, "tdpm: %s, %s%s: %dx%d, %s camera samples (%d-%d per pixel), %.2f s in all -> %s (preview %s)\n",
+                 a.scene.c_str(), opt.method.c_str(), ranksNote.c_str(), filmWidth, filmHeight,
                  formatCount(stats.cameraSamples).c_str(), stats.minSpp, stats.maxSpp, total.seconds(), output.c_str(),
                  preview.c_str());
     if (photonMethod)
@@ -437,7 +510,10 @@ int runRender(const RenderArgs& a) {
                    stats.bytesPerPhoton, stats.photonSeconds, static_cast<unsigned long long>(stats.timeEstimates),
                    static_cast<unsigned long long>(stats.standardEstimates));
   }
-  if (a.stats) printStats(stats);
+  if (a.stats) {
+    printStats(stats);
+    printRankStats(ranks);
+  }
   return 0;
 }
 

@@ -165,6 +165,22 @@ class PhotonStore {
     flags_[i] = uint16_t((flags_[i] & ~kAxisMask) | (uint16_t(axis) << kAxisShift));
   }
 
+  // ---- for whole stores exchanged between processes (render over MPI) ----
+  struct RawArrays {
+    float *x, *y, *z;
+    uint32_t* energy;
+    uint16_t *direction, *flags;
+  };
+  // Resizes to n photons and returns the arrays, for a caller that fills
+  // every element (the capacity is then exactly n).
+  RawArrays resizeForFill(size_t n) {
+    for (auto* v : {&x_, &y_, &z_}) v->resize(n);
+    energy_.resize(n);
+    direction_.resize(n);
+    flags_.resize(n);
+    return {x_.data(), y_.data(), z_.data(), energy_.data(), direction_.data(), flags_.data()};
+  }
+
  private:
   TimeQuantiser time_;
   std::vector<float> x_, y_, z_;

@@ -388,22 +388,23 @@ struct Tracer {
     return rays;
   }
 
-  // Traces batches [0, batches) in parallel into one store, in batch order.
+  // Traces batches [first, end) in parallel into one store, in batch order.
   // Batches are traced and appended a chunk at a time into a store reserved
   // for the expected count, so memory peaks near the final store's 20 bytes
   // per photon instead of holding every batch buffer and the result at once.
-  PhotonStore traceBatches(uint64_t batches, double energyScale, const Progress& progress, const char* stage,
-                           size_t expected, uint64_t* raysOut = nullptr) const {
+  PhotonStore traceBatches(uint64_t firstBatch, uint64_t endBatch, double energyScale, const Progress& progress,
+                           const char* stage, size_t expected, uint64_t* raysOut = nullptr) const {
     PhotonStore all(t0, t1);
     all.reserve(expected);
     std::atomic<uint64_t> rays{0};
     std::atomic<size_t> done{0};
+    const uint64_t batches = endBatch - firstBatch;
     // Counted in photon paths emitted (the bar's unit for "... photons" stages).
     const size_t paths = size_t(batches) * kPathsPerBatch;
     progress(stage, 0, paths);
     std::vector<PhotonStore> parts;
-    for (uint64_t first = 0; first < batches; first += kBatchesPerChunk) {
-      size_t count = size_t(std::min<uint64_t>(kBatchesPerChunk, batches - first));
+    for (uint64_t first = firstBatch; first < endBatch; first += kBatchesPerChunk) {
+      size_t count = size_t(std::min<uint64_t>(kBatchesPerChunk, endBatch - first));
       parts.assign(count, PhotonStore(t0, t1));
       tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t b = r.begin(); b != r.end(); ++b) {
@@ -417,6 +418,29 @@ struct Tracer {
     return all;
   }
 };
+
+// Every rank's photons, concatenated in rank order (= batch order, as each
+// rank traced a contiguous block of batches), on every rank.
+void allgatherStore(dist::Comm& comm, PhotonStore& store) {
+  if (!comm.distributed()) return;
+  std::vector<uint64_t> counts = comm.allgather(store.size());
+  uint64_t total = 0;
+  for (uint64_t c : counts) total += c;
+  PhotonStore all(store.t0(), store.t1());
+  PhotonStore::RawArrays a = all.resizeForFill(size_t(total));
+  auto gather = [&](const void* mine, void* out, uint64_t elementBytes) {
+    std::vector<uint64_t> bytes(counts.size());
+    for (size_t r = 0; r < counts.size(); ++r) bytes[r] = counts[r] * elementBytes;
+    comm.allgatherv(mine, out, bytes);
+  };
+  gather(store.xs(), a.x, 4);
+  gather(store.ys(), a.y, 4);
+  gather(store.zs(), a.z, 4);
+  gather(store.energies(), a.energy, 4);
+  gather(store.directions(), a.direction, 2);
+  gather(store.flags(), a.flags, 2);
+  store = std::move(all);
+}
 
 }  // namespace
 
@@ -450,14 +474,21 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   // Pilot: how many photons does a path store on average? Grow the pilot
   // (8x a round) until something is stored or a round would exceed the
   // path or ray budget; then the scene is taken to store nothing.
+  // Distributed, every rank traces its block of each round and the counts
+  // are summed (integers), so every rank takes the same decisions.
+  dist::Comm& comm = *settings.comm;
   uint64_t pilotBatches = kPilotBatches;
   size_t stored = 0;
   uint64_t pilotRays = 0;
   for (;;) {
-    uint64_t rays = 0;
-    PhotonStore pilot = tracer.traceBatches(pilotBatches, 1.0, Progress{}, stage, 0, &rays);
+    uint64_t rays = 0, lo = 0, hi = 0;
+    dist::blockRange(pilotBatches, comm.rank(), comm.size(), lo, hi);
+    PhotonStore pilot = tracer.traceBatches(lo, hi, 1.0, Progress{}, stage, 0, &rays);
+    uint64_t sums[2] = {pilot.size(), rays};
+    comm.allreduceSum(sums, 2);
+    rays = sums[1];
     pilotRays += rays;
-    stored = pilot.size();
+    stored = size_t(sums[0]);
     if (stored > 0) break;
     double raysPerBatch = std::max(1.0, double(rays) / double(pilotBatches));
     uint64_t next = std::min({pilotBatches * 8, kMaxPilotPaths / kPathsPerBatch,
@@ -491,9 +522,14 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   // The final count is Poisson-like around the wanted one: reserve a few
   // standard deviations more so the store rarely needs to grow.
   size_t expected = settings.storedWanted + size_t(4.0 * std::sqrt(double(settings.storedWanted))) + 1024;
-  result.store = tracer.traceBatches(batches, energyScale, progress, stage, expected, &result.rays);
+  uint64_t lo = 0, hi = 0;
+  dist::blockRange(batches, comm.rank(), comm.size(), lo, hi);
+  if (comm.distributed()) expected = size_t(double(expected) * double(hi - lo) / double(batches)) + 1024;
+  result.store = tracer.traceBatches(lo, hi, energyScale, progress, stage, expected, &result.rays);
+  comm.allreduceSum(&result.rays, 1);
   result.rays += pilotRays;
   result.store.shrinkToFit();
+  allgatherStore(comm, result.store);
   result.seconds = timer.seconds();
   return result;
 }

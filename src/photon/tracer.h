@@ -13,6 +13,7 @@
 #include <string>
 
 #include "core/progress.h"
+#include "dist/comm.h"
 #include "photon/store.h"
 #include "sampling/sampler.h"
 #include "scene/scene.h"
@@ -36,6 +37,10 @@ struct TraceSettings {
   // (docs/sampling.md): random = one PCG32 per batch (the maps of old),
   // sobol = Owen-scrambled Sobol indexed by the global path index.
   SamplerKind sampler = SamplerKind::Random;
+  // Distributed: every rank traces a contiguous block of the batches (pilot
+  // included) and receives everyone's photons in batch order, so each rank
+  // holds the map one process would trace (dist/comm.h).
+  dist::Comm* comm = &dist::local();
 };
 
 struct TraceResult {

@@ -20,6 +20,7 @@
 #include "render/photon_integrator.h"
 #include "render/memory_budget.h"
 #include "render/photon_map.h"
+#include "render/pixel_share.h"
 #include "render/tile_loop.h"
 #include "sampling/sampler.h"
 
@@ -93,6 +94,9 @@ struct SamplingPlan {
   SamplerKind sampler = SamplerKind::Sobol;
   bool sampleTime = true;       // false: a scene without motion draws no times
   float fixedTime01 = -1.0f;    // >= 0: every sample at this time (accumulation frames)
+  // Distributed render: this rank samples only its own tiles, and the
+  // half-buffer errors of every pixel are shared between passes.
+  dist::Comm* comm = &dist::local();
 };
 
 template <class Integrator>
@@ -131,7 +135,7 @@ void samplePass(const Scene& scene, const Integrator& integrator, const Sampling
         }
       }
     integrator.flush(s.state);
-  });
+  }, tileShareOf(*plan.comm));
 }
 
 // Adaptive sampling in passes over the whole image: every pixel takes
@@ -146,7 +150,9 @@ void samplePass(const Scene& scene, const Integrator& integrator, const Sampling
 // where this one is within 0.4%). Decisions use only finished passes, so
 // the image does not depend on threads or tile order. The final value of a
 // pixel is the mean of all its samples, and its sample indices continue
-// from pass to pass.
+// from pass to pass. A distributed render samples its own tiles and takes
+// the other ranks' errors before each decision (the neighbourhood of a
+// pixel crosses tiles), so every rank decides alike, as one process would.
 template <class PixelSampler, class Integrator>
 void renderPixelsWith(const Scene& scene, const Integrator& integrator, const SamplingPlan& plan, const char* stage,
                       const Progress& progress, Film& film) {
@@ -156,12 +162,14 @@ void renderPixelsWith(const Scene& scene, const Integrator& integrator, const Sa
   std::vector<uint8_t> active(n, 1);
   std::vector<float> err(n);
   uint32_t taken = 0;
+  dist::testFailurePoint(*plan.comm, "render");
   for (int pass = 0;; ++pass) {
     std::string name = pass == 0 ? std::string(stage) : std::string(stage) + " (adaptive pass " + std::to_string(pass) + ")";
     samplePass<PixelSampler>(scene, integrator, plan, taken, plan.batch, active, accs, name, progress, w, h);
     taken += uint32_t(plan.batch);
     if (int(taken) + plan.batch > plan.maxSpp) break;
     for (size_t i = 0; i < n; ++i) err[i] = float(std::min(accs[i].halfError(), double(FLT_MAX)));
+    sharePixels(*plan.comm, w, h, err, true);
     bool any = false;
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
@@ -207,9 +215,11 @@ struct Maps {
 };
 
 Maps tracePhotonMaps(const Scene& scene, const RenderOptions& opt, size_t causticWanted, size_t globalWanted,
-                     bool spreadInTime, float fixedTime01, uint64_t seed, const Progress& progress, RenderStats& st) {
+                     bool spreadInTime, float fixedTime01, uint64_t seed, const Progress& progress, RenderStats& st,
+                     dist::Comm& comm) {
   Maps maps;
   PhotonMapSettings ms;
+  ms.trace.comm = &comm;
   ms.spaceTime = opt.spaceTime4D && spreadInTime;
   ms.kappa = opt.kappa;
   ms.trace.seed = seed;
@@ -334,12 +344,19 @@ bool isRenderMethod(const std::string& name) {
   return false;
 }
 
-Film render(const Scene& scene, const RenderOptions& opt, const Progress& progress, RenderStats& st) {
+Film render(const Scene& scene, const RenderOptions& opt, const Progress& progress, RenderStats& st, dist::Comm& comm) {
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
   if (!isRenderMethod(opt.method)) throw Error("unknown method '" + opt.method + "'");
   // Before any work: an image or photon budget that cannot fit is an error,
-  // not an OOM kill (render/memory_budget.h).
-  checkMemoryBudget(scene, opt, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
+  // not an OOM kill (render/memory_budget.h). Every rank holds the whole
+  // photon maps, so every rank checks; one rank short of memory stops all.
+  std::string budgetError;
+  try {
+    checkMemoryBudget(scene, opt, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
+  } catch (const Error& e) {
+    budgetError = e.what();
+  }
+  dist::raiseIfAnyFailed(comm, budgetError);
   Timer timer;
   st = RenderStats{};
   if (scene.lights.empty() && scene.background.isBlack())
@@ -361,6 +378,7 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
   plan.sampler = opt.sampler;
   // A scene with no motion at all draws no time samples.
   plan.sampleTime = scene.hasMotion;
+  plan.comm = &comm;
 
   if (opt.method == "pathtrace") {
     PathTracer pt(scene, opt.maxDepth);
@@ -378,7 +396,7 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
     for (int f = 0; f < frames; ++f) {
       float t01 = (float(f) + 0.5f) / float(frames);
       Maps maps = tracePhotonMaps(scene, opt, causticPer, globalPer, false, t01, hashCombine(opt.seed, uint64_t(f)),
-                                  progress, st);
+                                  progress, st, comm);
       PhotonIntegrator integ(scene, maps.caustic.get(), maps.global.get(), integratorSettings(scene, opt, false));
       framePlan.fixedTime01 = t01;
       framePlan.seed = hashCombine(opt.seed, 0xacc0ull + uint64_t(f));
@@ -404,12 +422,22 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
     // static: photons at shutter open; standard and time: spread in time.
     bool spread = opt.method != "static" && scene.hasMotion;
     bool timeDependent = opt.method == "time" && scene.hasMotion;
-    Maps maps = tracePhotonMaps(scene, opt, opt.causticPhotons, opt.globalPhotons, spread, 0.0f, opt.seed, progress, st);
+    Maps maps = tracePhotonMaps(scene, opt, opt.causticPhotons, opt.globalPhotons, spread, 0.0f, opt.seed, progress, st, comm);
     PhotonIntegrator integ(scene, maps.caustic.get(), maps.global.get(), integratorSettings(scene, opt, timeDependent));
     renderPixels(scene, integ, plan, "render", progress, film);
     EstimateCounts c = integ.counts();
     st.standardEstimates = c.standard;
     st.timeEstimates = c.timeDependent;
+  }
+  if (comm.distributed()) {
+    // Rank 0 gathers the film; estimate counts are summed (integers).
+    sharePixels(comm, film.width, film.height, film.color, false);
+    sharePixels(comm, film.width, film.height, film.sampleCount, false);
+    sharePixels(comm, film.width, film.height, film.varianceOfMean, false);
+    uint64_t counts[2] = {st.standardEstimates, st.timeEstimates};
+    comm.allreduceSum(counts, 2);
+    st.standardEstimates = counts[0];
+    st.timeEstimates = counts[1];
   }
   finishStats(film, st);
   st.seconds = timer.seconds();

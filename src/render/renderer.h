@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/progress.h"
+#include "dist/comm.h"
 #include "estimate/estimators.h"
 #include "render/film.h"
 #include "sampling/sampler.h"
@@ -86,7 +87,12 @@ bool isRenderMethod(const std::string& name);
 // Throws tdpm::Error, before any work, when the image and the photon maps
 // the options ask for cannot fit in the machine's available memory
 // (render/memory_budget.h checkMemoryBudget with MemAvailable).
-Film render(const Scene& scene, const RenderOptions& options, const Progress& progress, RenderStats& stats);
+// Distributed (comm.size() > 1, every rank calls it alike): photon batches
+// and image tiles are split over the ranks, every rank gets the whole photon
+// maps, and rank 0 alone returns the whole film (the others return their own
+// tiles only); bit-identical to one process (docs/distributed.md).
+Film render(const Scene& scene, const RenderOptions& options, const Progress& progress, RenderStats& stats,
+            dist::Comm& comm = dist::local());
 
 // ---- photon memory budget ----
 // Peak bytes the photon passes hold for maps of `caustic` and `global`

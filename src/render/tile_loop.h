@@ -4,23 +4,26 @@
 // a per-thread scratch object it may reuse (no allocation per sample, no
 // locks). Progress is reported once per finished tile. Results must depend
 // only on the pixel (seeded per pixel), so they are identical for any
-// thread count and any tile order.
+// thread count and any tile order. A distributed render (dist/) gives each
+// rank the tiles its TileShare owns; the loop then visits only those.
 //
-// Tiles are handed out scattered over the image, not row by row: tile
-// number i is (i * stride) mod total with stride near 0.618 total and
-// coprime to it (a permutation: a Weyl sequence). The tiles finished at
-// any moment are then a fair sample of the image, so the progress bar's
-// time left, measured from them, holds; in row order the cheap sky came
-// first and the bar said "0:04 left" at 25% of a 29 s render
+// Tiles are handed out scattered over the image (or the rank's share), not
+// row by row: tile number k is (k * stride) mod total with stride near
+// 0.618 total and coprime to it (a permutation: a Weyl sequence). The tiles
+// finished at any moment are then a fair sample of the image, so the
+// progress bar's time left, measured from them, holds; in row order the
+// cheap sky came first and the bar said "0:04 left" at 25% of a 29 s render
 // (scenes/glass-ball.json, cli/progress_bar.h).
 #pragma once
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/progress.h"
 
@@ -44,11 +47,39 @@ inline size_t tileOrderStride(size_t total) {
   return s;
 }
 
-template <class Scratch, class TileFn>
-void forEachTile(int width, int height, const std::string& stage, const Progress& progress, TileFn&& fn) {
+// Which tiles one rank of a distributed render owns: tile (tx, ty) belongs
+// to rank (tx + ty) mod size, diagonal stripes, so every rank gets tiles
+// from every part of the image (a caustic or a bright window is shared) and
+// the split is fixed in advance: no work queue, and every rank knows who
+// renders each pixel. One process (size 1) owns every tile.
+struct TileShare {
+  int rank = 0, size = 1;
+  bool owns(int tx, int ty) const { return (tx + ty) % size == rank; }
+  bool ownsTileOf(int x, int y) const { return owns(x / kTileSize, y / kTileSize); }
+};
+
+// Tile indices (row-major over the tile grid) owned by `share`, ascending.
+inline std::vector<size_t> ownedTiles(int width, int height, const TileShare& share) {
   const int tilesX = (width + kTileSize - 1) / kTileSize;
   const int tilesY = (height + kTileSize - 1) / kTileSize;
-  const size_t total = size_t(tilesX) * size_t(tilesY);
+  std::vector<size_t> tiles;
+  for (int ty = 0; ty < tilesY; ++ty)
+    for (int tx = 0; tx < tilesX; ++tx)
+      if (share.owns(tx, ty)) tiles.push_back(size_t(ty) * size_t(tilesX) + size_t(tx));
+  return tiles;
+}
+
+inline Tile tileAt(size_t index, int width, int height) {
+  const int tilesX = (width + kTileSize - 1) / kTileSize;
+  int tx = int(index % size_t(tilesX)), ty = int(index / size_t(tilesX));
+  return Tile{tx * kTileSize, ty * kTileSize, std::min(width, (tx + 1) * kTileSize), std::min(height, (ty + 1) * kTileSize)};
+}
+
+template <class Scratch, class TileFn>
+void forEachTile(int width, int height, const std::string& stage, const Progress& progress, TileFn&& fn,
+                 const TileShare& share = {}) {
+  const std::vector<size_t> tiles = ownedTiles(width, height, share);
+  const size_t total = tiles.size();
   const size_t stride = tileOrderStride(total);
   std::atomic<size_t> done{0};
   tbb::enumerable_thread_specific<Scratch> scratch;
@@ -57,8 +88,7 @@ void forEachTile(int width, int height, const std::string& stage, const Progress
     Scratch& s = scratch.local();
     for (size_t k = r.begin(); k != r.end(); ++k) {
       const size_t i = size_t((uint64_t(k) * stride) % total);  // tiles <= 2^24: no overflow
-      int tx = int(i % size_t(tilesX)), ty = int(i / size_t(tilesX));
-      Tile t{tx * kTileSize, ty * kTileSize, std::min(width, (tx + 1) * kTileSize), std::min(height, (ty + 1) * kTileSize)};
+      Tile t = tileAt(tiles[i], width, height);
       fn(t, s);
       progress(stage, done.fetch_add(1) + 1, total);
     }

@@ -1,0 +1,16 @@
+// dist/mpi_backend.h — what dist/comm.cpp needs from dist/mpi_comm.cpp, the
+// one file that includes mpi.h (compiled only when TDPM_MPI is on).
+#pragma once
+
+namespace tdpm::dist {
+
+class Comm;
+
+namespace mpi {
+// MPI_Init (MPI_THREAD_FUNNELED: only the thread that runs main talks MPI;
+// TBB workers never do). Returns the world Comm, alive until stop().
+Comm* start(int& argc, char**& argv);
+void stop();
+}  // namespace mpi
+
+}  // namespace tdpm::dist

@@ -1,0 +1,160 @@
+// dist/mpi_comm.cpp — the Comm of an `mpirun` job, on MPI_COMM_WORLD: the
+// only file of tdpm that includes mpi.h (compiled only with TDPM_MPI).
+// Only the main thread calls MPI (MPI_THREAD_FUNNELED); TBB workers never do.
+#include <mpi.h>
+
+#include <algorithm>
+#include <chrono>
+#include <climits>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+
+#include "dist/comm.h"
+#include "dist/mpi_backend.h"
+
+namespace tdpm::dist {
+
+namespace {
+
+// MPI counts are int: larger payloads go in pieces of this many bytes.
+constexpr uint64_t kPiece = uint64_t(1) << 30;
+
+double threadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+// Wall and CPU time of one collective, added to the rank's CommStats.
+class Clock {
+ public:
+  explicit Clock(CommStats& s) : s_(s), start_(std::chrono::steady_clock::now()), cpu_(threadCpuSeconds()) {}
+  ~Clock() {
+    s_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    s_.cpuSeconds += threadCpuSeconds() - cpu_;
+  }
+
+ private:
+  CommStats& s_;
+  std::chrono::steady_clock::time_point start_;
+  double cpu_;
+};
+
+class MpiComm final : public Comm {
+ public:
+  MpiComm() {
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &size_);
+  }
+  int rank() const override { return rank_; }
+  int size() const override { return size_; }
+
+  void allgatherv(const void* mine, void* all, const std::vector<uint64_t>& bytes) override {
+    Clock c(stats_);
+    stats_.bytesSent += bytes[size_t(rank_)] * uint64_t(size_ - 1);
+    std::vector<int> counts, displs;
+    if (fitsInt(bytes, counts, displs)) {
+      MPI_Allgatherv(mine, counts[size_t(rank_)], MPI_BYTE, all, counts.data(), displs.data(), MPI_BYTE,
+                     MPI_COMM_WORLD);
+      return;
+    }
+    // Too large for int counts: each rank broadcasts its block in pieces.
+    uint64_t offset = 0;
+    for (int r = 0; r < size_; ++r) {
+      char* block = static_cast<char*>(all) + offset;
+      if (r == rank_ && block != mine) std::copy_n(static_cast<const char*>(mine), size_t(bytes[size_t(r)]), block);
+      bcastPieces(block, bytes[size_t(r)], r);
+      offset += bytes[size_t(r)];
+    }
+  }
+
+  void gathervToRoot(const void* mine, void* all, const std::vector<uint64_t>& bytes) override {
+    Clock c(stats_);
+    if (rank_ != 0) stats_.bytesSent += bytes[size_t(rank_)];
+    std::vector<int> counts, displs;
+    if (fitsInt(bytes, counts, displs)) {
+      MPI_Gatherv(mine, counts[size_t(rank_)], MPI_BYTE, all, counts.data(), displs.data(), MPI_BYTE, 0,
+                  MPI_COMM_WORLD);
+      return;
+    }
+    uint64_t offset = 0;
+    for (int r = 0; r < size_; ++r) {
+      uint64_t n = bytes[size_t(r)];
+      if (rank_ == 0 && r == 0) std::copy_n(static_cast<const char*>(mine), size_t(n), static_cast<char*>(all));
+      for (uint64_t done = 0; done < n; done += kPiece) {
+        int piece = int(std::min(kPiece, n - done));
+        if (rank_ == 0 && r != 0)
+          MPI_Recv(static_cast<char*>(all) + offset + done, piece, MPI_BYTE, r, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        else if (rank_ == r && r != 0)
+          MPI_Send(static_cast<const char*>(mine) + done, piece, MPI_BYTE, 0, 0, MPI_COMM_WORLD);
+      }
+      offset += n;
+    }
+  }
+
+  void broadcast(void* data, uint64_t n, int from) override {
+    Clock c(stats_);
+    if (rank_ == from) stats_.bytesSent += n * uint64_t(size_ - 1);
+    bcastPieces(static_cast<char*>(data), n, from);
+  }
+
+  void allreduceSum(uint64_t* values, size_t n) override {
+    Clock c(stats_);
+    stats_.bytesSent += uint64_t(n) * 8 * uint64_t(size_ - 1);
+    for (size_t done = 0; done < n; done += size_t(kPiece / 8)) {
+      int piece = int(std::min<size_t>(size_t(kPiece / 8), n - done));
+      MPI_Allreduce(MPI_IN_PLACE, values + done, piece, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+    }
+  }
+
+  [[noreturn]] void abort(const std::string& message, int code) override {
+    std::fprintf(stderr, "%s\n", message.c_str());
+    std::fflush(stderr);
+    MPI_Abort(MPI_COMM_WORLD, code);
+    std::_Exit(code);  // MPI_Abort does not return; if it did, still end this rank
+  }
+
+ private:
+  static bool fitsInt(const std::vector<uint64_t>& bytes, std::vector<int>& counts, std::vector<int>& displs) {
+    uint64_t offset = 0;
+    for (uint64_t b : bytes) {
+      if (b > uint64_t(INT_MAX) || offset > uint64_t(INT_MAX)) return false;
+      counts.push_back(int(b));
+      displs.push_back(int(offset));
+      offset += b;
+    }
+    return true;
+  }
+  static void bcastPieces(char* data, uint64_t n, int from) {
+    for (uint64_t done = 0; done < n; done += kPiece)
+      MPI_Bcast(data + done, int(std::min(kPiece, n - done)), MPI_BYTE, from, MPI_COMM_WORLD);
+  }
+
+  int rank_ = 0, size_ = 1;
+};
+
+MpiComm* gComm = nullptr;
+
+}  // namespace
+
+namespace mpi {
+
+Comm* start(int& argc, char**& argv) {
+  int provided = 0;
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+  gComm = new MpiComm();
+  return gComm;
+}
+
+void stop() {
+  delete gComm;
+  gComm = nullptr;
+  int finalized = 0;
+  MPI_Finalized(&finalized);
+  if (!finalized) MPI_Finalize();
+}
+
+}  // namespace mpi
+
+}  // namespace tdpm::dist

@@ -1,0 +1,136 @@
+// tests/test_dist.cpp — the distribution module (dist/) and the render's
+// split of work, without MPI: block ranges of photon batches, the tile
+// interleave, pixel sharing with one process, error agreement, launcher
+// detection. The multi-process runs are in tests/test_dist_mpi.cpp.
+#include <doctest/doctest.h>
+
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "dist/comm.h"
+#include "render/pixel_share.h"
+#include "render/tile_loop.h"
+
+using namespace tdpm;
+
+TEST_CASE("dist: block ranges of batches are contiguous, in rank order, and cover everything") {
+  for (uint64_t total : {0ull, 1ull, 7ull, 16ull, 391ull, 100003ull})
+    for (int size = 1; size <= 9; ++size) {
+      uint64_t next = 0, largest = 0, smallest = ~0ull;
+      for (int r = 0; r < size; ++r) {
+        uint64_t lo = 0, hi = 0;
+        dist::blockRange(total, r, size, lo, hi);
+        CHECK(lo == next);
+        CHECK(hi >= lo);
+        largest = std::max(largest, hi - lo);
+        smallest = std::min(smallest, hi - lo);
+        next = hi;
+      }
+      CHECK(next == total);
+      CHECK(largest - smallest <= 1);  // balanced to one batch
+    }
+}
+
+TEST_CASE("dist: every tile has exactly one owner, and the shares differ by at most a diagonal") {
+  for (int size = 1; size <= 6; ++size)
+    for (auto wh : {std::pair<int, int>{1, 1}, {17, 5}, {160, 120}, {333, 47}}) {
+      int w = wh.first, h = wh.second;
+      size_t tiles = size_t((w + kTileSize - 1) / kTileSize) * size_t((h + kTileSize - 1) / kTileSize);
+      std::vector<int> owners(tiles, 0);
+      size_t most = 0, least = tiles;
+      for (int r = 0; r < size; ++r) {
+        std::vector<size_t> mine = ownedTiles(w, h, TileShare{r, size});
+        for (size_t i : mine) ++owners[i];
+        most = std::max(most, mine.size());
+        least = std::min(least, mine.size());
+      }
+      for (int o : owners) CHECK(o == 1);
+      // Diagonal stripes: the counts differ by at most one stripe's length.
+      int tilesX = (w + kTileSize - 1) / kTileSize, tilesY = (h + kTileSize - 1) / kTileSize;
+      CHECK(most - least <= size_t(std::min(tilesX, tilesY)));
+    }
+}
+
+TEST_CASE("dist: one process shares pixels as a no-op and its collectives copy") {
+  dist::Comm& one = dist::local();
+  CHECK(one.rank() == 0);
+  CHECK(one.size() == 1);
+  CHECK_FALSE(one.distributed());
+  std::vector<float> px(40 * 30);
+  for (size_t i = 0; i < px.size(); ++i) px[i] = float(i) * 0.5f;
+  std::vector<float> before = px;
+  sharePixels(one, 40, 30, px, true);
+  sharePixels(one, 40, 30, px, false);
+  CHECK(px == before);
+  std::vector<uint64_t> all = one.allgather(42);
+  REQUIRE(all.size() == 1);
+  CHECK(all[0] == 42);
+  CHECK(one.broadcastInt(5) == 5);
+  uint64_t v[2] = {3, 4};
+  one.allreduceSum(v, 2);
+  CHECK(v[0] == 3);
+  CHECK(v[1] == 4);
+}
+
+TEST_CASE("dist: an error on one process is raised as the agreed error; no error, nothing raised") {
+  dist::Comm& one = dist::local();
+  CHECK_NOTHROW(dist::raiseIfAnyFailed(one, ""));
+  std::string what;
+  try {
+    dist::raiseIfAnyFailed(one, "scene.json:3: bad");
+  } catch (const dist::AgreedError& e) {
+    what = e.what();
+  }
+  CHECK(what == "scene.json:3: bad");
+}
+
+TEST_CASE("dist: a launcher is recognised from its environment, a plain run is not") {
+  const char* names[] = {"OMPI_COMM_WORLD_SIZE", "OMPI_COMM_WORLD_RANK", "PMI_SIZE", "PMI_RANK", "PMIX_SIZE", "PMIX_RANK"};
+  std::vector<std::pair<std::string, std::string>> saved;
+  for (const char* n : names)
+    if (const char* v = std::getenv(n)) saved.emplace_back(n, v);
+  for (const char* n : names) unsetenv(n);
+  int size = -1, rank = -1;
+  CHECK_FALSE(dist::launchedByMpirun(&size, &rank));
+  CHECK(size == 1);
+  CHECK(rank == 0);
+  setenv("OMPI_COMM_WORLD_SIZE", "4", 1);
+  setenv("OMPI_COMM_WORLD_RANK", "3", 1);
+  CHECK(dist::launchedByMpirun(&size, &rank));
+  CHECK(size == 4);
+  CHECK(rank == 3);
+  unsetenv("OMPI_COMM_WORLD_SIZE");
+  unsetenv("OMPI_COMM_WORLD_RANK");
+  setenv("PMI_SIZE", "2", 1);
+  setenv("PMI_RANK", "1", 1);
+  CHECK(dist::launchedByMpirun(&size, &rank));
+  CHECK(size == 2);
+  CHECK(rank == 1);
+  unsetenv("PMI_SIZE");
+  unsetenv("PMI_RANK");
+  for (auto& kv : saved) setenv(kv.first.c_str(), kv.second.c_str(), 1);
+}
+
+TEST_CASE("dist: a round of units is combined on rank 0 in unit order (one process: its own unit)") {
+  dist::Comm& one = dist::local();
+  std::vector<float> sum(3, 0.0f);
+  int calls = 0;
+  auto add = [&](const float* v, size_t n) {
+    ++calls;
+    REQUIRE(n == sum.size());
+    for (size_t i = 0; i < n; ++i) sum[i] += v[i];
+  };
+  dist::combineRoundOnRoot(one, std::vector<float>{1.0f, 2.0f, 3.0f}, true, add);
+  dist::combineRoundOnRoot(one, std::vector<float>{0.5f, 0.25f, 0.125f}, true, add);
+  dist::combineRoundOnRoot(one, std::vector<float>{9.0f, 9.0f, 9.0f}, false, add);  // no unit: not added
+  CHECK(calls == 2);
+  CHECK(sum == std::vector<float>{1.5f, 2.25f, 3.125f});
+  // Units dealt round-robin: rank r of N owns r, r + N, ...
+  for (uint64_t u = 0; u < 20; ++u) {
+    int owners = 0;
+    for (int r = 0; r < 3; ++r) owners += dist::ownsUnit(u, r, 3);
+    CHECK(owners == 1);
+    CHECK(dist::ownsUnit(u, int(u % 3), 3));
+  }
+}

@@ -1,0 +1,162 @@
+// tests/test_dist_mpi.cpp — tdpm under `mpirun -np 2` on this machine
+// (loopback; --oversubscribe for 2 cores, root allowed): the images equal
+// one process's bit for bit, a bad scene is reported once and every rank
+// exits 1, a failing or dying rank ends the job with a message instead of
+// a hang. Built into the suite only with TDPM_MPI (tests/CMakeLists.txt
+// registers a skipped test otherwise). Small images and few photons.
+#include <doctest/doctest.h>
+
+#include <cstring>
+#include <string>
+
+#include "cli_harness.h"
+#include "image/exr.h"
+
+#ifdef TDPM_MPIEXEC
+
+using namespace tdpm;
+using tdpm::test::CommandResult;
+
+namespace {
+
+// mpirun of Open MPI; `timeout` turns a hang into exit status 124.
+CommandResult runMpi(int ranks, const std::string& env, const std::string& args, bool throughShell = false) {
+  std::string tdpm = std::string("'") + TDPM_BINARY + "' " + args;
+  std::string cmd = "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 " + env + " timeout 120 '" +
+                    TDPM_MPIEXEC + "' --oversubscribe -np " + std::to_string(ranks) + " " +
+                    (throughShell ? "sh -c \"" + tdpm + "; echo rank-exit \\$?\"" : tdpm) + " 2>&1 < /dev/null";
+  CommandResult r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  int status = pclose(p);
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+size_t occurrences(const std::string& text, const std::string& what) {
+  size_t n = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+// Every value of the colour and of every extra layer (spp, variance), as bits.
+bool sameBits(const image::ExrFile& a, const image::ExrFile& b) {
+  if (a.color.width != b.color.width || a.color.height != b.color.height) return false;
+  if (std::memcmp(a.color.pixels.data(), b.color.pixels.data(), a.color.pixels.size() * sizeof(Rgb)) != 0) return false;
+  if (a.extra.size() != b.extra.size()) return false;
+  for (size_t i = 0; i < a.extra.size(); ++i) {
+    if (a.extra[i].name != b.extra[i].name || a.extra[i].values.size() != b.extra[i].values.size()) return false;
+    if (std::memcmp(a.extra[i].values.data(), b.extra[i].values.data(), a.extra[i].values.size() * sizeof(float)) != 0)
+      return false;
+  }
+  return true;
+}
+
+void checkSameImage(const std::string& method, const std::string& extra, int ranks = 2) {
+  std::string dir = test::makeTempDir();
+  std::string args = "render '" + std::string(TDPM_SOURCE_DIR) + "/scenes/cube-caustic.json' -m " + method +
+                     " --resolution 48x32 --spp 4 --max-spp 68 --contrast 0.2 --photons 6000 --global-photons 2000"
+                     " -q " + extra;
+  CommandResult one = test::runTdpm(args + " --seed 7 -t 2 -o " + dir + "/one.exr");
+  REQUIRE_MESSAGE(one.exitCode == 0, one.output);
+  CommandResult two = runMpi(ranks, "", args + " --seed 7 -t 1 -o " + dir + "/two.exr");
+  REQUIRE_MESSAGE(two.exitCode == 0, two.output);
+  image::ExrFile a = image::readExr(dir + "/one.exr"), b = image::readExr(dir + "/two.exr");
+  CHECK(b.metadata["tdpm/method"] == method);
+  CHECK_MESSAGE(sameBits(a, b), method << ": " << ranks << " ranks differ from one process");
+  // The comparison can fail: another seed gives another image.
+  CommandResult other = test::runTdpm(args + " --seed 8 -t 2 -o " + dir + "/other.exr");
+  REQUIRE(other.exitCode == 0);
+  CHECK_FALSE(sameBits(a, image::readExr(dir + "/other.exr")));
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
+}  // namespace
+
+TEST_CASE("mpi: the collectives of dist::Comm on 3 ranks (tests/mpi/dist_selftest.cpp)") {
+  std::string cmd = "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 '" + std::string(TDPM_MPIEXEC) +
+                    "' --oversubscribe -np 3 '" + TDPM_DIST_SELFTEST + "' 2>&1 < /dev/null";
+  std::string out;
+  FILE* p = popen(cmd.c_str(), "r");
+  REQUIRE(p);
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  int status = pclose(p);
+  CHECK_MESSAGE((WIFEXITED(status) && WEXITSTATUS(status) == 0), out);
+  CHECK_MESSAGE(out.find("dist_selftest: every check passed on 3 ranks") != std::string::npos, out);
+}
+
+TEST_CASE("mpi: 2 ranks render the time method bit-identical to one process (adaptive passes included)") {
+  checkSameImage("time", "");
+}
+
+TEST_CASE("mpi: 3 ranks (uneven shares of batches and tiles) render the time method bit-identical to one process") {
+  checkSameImage("time", "--search 4d", 3);
+}
+
+TEST_CASE("mpi: 2 ranks render accumulation bit-identical to one process") {
+  checkSameImage("accumulation", "--frames 4");
+}
+
+TEST_CASE("mpi: 2 ranks path-trace bit-identical to one process") { checkSameImage("pathtrace", ""); }
+
+TEST_CASE("mpi: rank 0 alone prints the summary; --stats gives every rank's communication") {
+  std::string dir = test::makeTempDir();
+  CommandResult r = runMpi(2, "",
+                           "render '" + std::string(TDPM_SOURCE_DIR) + "/scenes/cube-caustic.json' -m time "
+                           "--resolution 32x24 --spp 2 --photons 3000 --global-photons 1000 -t 1 --stats -o " +
+                               dir + "/s.exr");
+  REQUIRE_MESSAGE(r.exitCode == 0, r.output);
+  CHECK(occurrences(r.output, "on 2 ranks: 32x24") == 1);
+  CHECK(occurrences(r.output, "tdpm: stats:") == 1);
+  CHECK(occurrences(r.output, "  rank 0: ") == 1);
+  CHECK(occurrences(r.output, "  rank 1: ") == 1);
+  // Rank 1 sends its photons (20 bytes each) and its tiles: not nothing.
+  size_t at = r.output.find("  rank 1: ");
+  REQUIRE(at != std::string::npos);
+  CHECK(std::strtoull(r.output.c_str() + at + 10, nullptr, 10) > 3000 * 20 / 2);
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
+TEST_CASE("mpi: a bad scene is reported once and every rank exits 1") {
+  std::string dir = test::makeTempDir();
+  test::writeFile(dir + "/bad.json", "{\"camera\": 3}\n");
+  CommandResult r = runMpi(2, "", "render '" + dir + "/bad.json' -o '" + dir + "/bad.exr'", true);
+  CHECK(occurrences(r.output, "tdpm: error: ") == 1);
+  CHECK(occurrences(r.output, "bad.json:1: camera: expected an object") == 1);
+  CHECK(occurrences(r.output, "rank-exit 1") == 2);
+  CHECK_FALSE(test::fileExists(dir + "/bad.exr"));
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
+TEST_CASE("mpi: a rank that fails alone while loading is named, once, and every rank exits 1") {
+  std::string dir = test::makeTempDir();
+  CommandResult r = runMpi(2, "TDPM_DIST_TEST_FAIL=1:load",
+                           "render '" + std::string(TDPM_SOURCE_DIR) + "/scenes/cube-caustic.json' --resolution 16x16 "
+                           "--spp 1 -q -o " + dir + "/x.exr", true);
+  CHECK(occurrences(r.output, "tdpm: error: rank 1: TDPM_DIST_TEST_FAIL: injected failure at 'load'") == 1);
+  CHECK(occurrences(r.output, "rank-exit 1") == 2);
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
+TEST_CASE("mpi: a rank that fails or dies during the render ends the job, with a message, without a hang") {
+  std::string dir = test::makeTempDir();
+  std::string args = "render '" + std::string(TDPM_SOURCE_DIR) + "/scenes/cube-caustic.json' -m time "
+                     "--resolution 32x24 --spp 2 --photons 3000 --global-photons 1000 -t 1 -q -o " + dir + "/x.exr";
+  CommandResult failed = runMpi(2, "TDPM_DIST_TEST_FAIL=1:render", args);
+  CHECK(failed.exitCode != 0);
+  CHECK(failed.exitCode != 124);  // not ended by the timeout: no hang
+  CHECK(failed.output.find("injected failure at 'render' (rank 1 of 2; ending the job)") != std::string::npos);
+  CommandResult died = runMpi(2, "TDPM_DIST_TEST_FAIL=1:render:crash", args);
+  CHECK(died.exitCode != 0);
+  CHECK(died.exitCode != 124);
+  CHECK(died.output.find("exited") != std::string::npos);  // mpirun names the rank that exited
+  CHECK_FALSE(test::fileExists(dir + "/x.exr"));
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
+#endif  // TDPM_MPIEXEC
