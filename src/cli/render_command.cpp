@@ -389,12 +389,12 @@ int runRender(const RenderArgs& a) {
   float exposure = 0.0f;
   std::unique_ptr<Scene> scene;
   std::string setupError;
-  try {
-  if (a.method && !isRenderMethod(*a.method))
-    throw Error("--method: unknown method '" + *a.method + "' (expected " + methodList() + ")");
   // The --progressive flag of issue 10 enables this (and --resume): at merge,
   // `= a.progressive`.
   const bool progressive = false;
+  try {
+  if (a.method && !isRenderMethod(*a.method))
+    throw Error("--method: unknown method '" + *a.method + "' (expected " + methodList() + ")");
   checkResumeFlags(a.resume ? &*a.resume : nullptr, progressive);
   int width = 0, height = 0;
   if (a.resolution) parseResolution(*a.resolution, width, height);
