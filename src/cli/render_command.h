@@ -25,6 +25,7 @@ struct RenderArgs {
   std::optional<std::string> search, kernelSpace, kernelTime;
   std::optional<std::string> sampler;
   std::optional<float> fraction, kappa, maxRadius, maxDt;
+  std::optional<float> kernelFootprint;
   bool globalDirect = false;
   int threads = 0;  // 0: all cores
   bool quiet = false;
