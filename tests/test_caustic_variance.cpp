@@ -28,6 +28,16 @@ scene::SceneDescription causticScene(int width, int height) {
   scene::SceneDescription d = scene::loadScene(std::string(TDPM_SOURCE_DIR) + kScene);
   d.camera.width = width;
   d.camera.height = height;
+  // STUDY_LIGHT=area: the same scene under a small area light (0.25 x 0.25,
+  // same place and power) instead of the point light (studies only).
+  const char* light = std::getenv("STUDY_LIGHT");
+  if (light && std::string(light) == "area") {
+    scene::LightDesc& l = d.lights.at(0);
+    l.type = scene::LightDesc::Type::Area;
+    l.areaSize = {0.25f, 0.25f};
+    l.placement.translate = l.position;
+    l.position = {0, 0, 0};
+  }
   return d;
 }
 
