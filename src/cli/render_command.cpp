@@ -247,6 +247,7 @@ RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc,
   o.kappa = pick(a.kappa, sc.kappa, o.kappa);
   if (a.maxRadius || sc.maxRadius) o.estimate.maxRadius = pick(a.maxRadius, sc.maxRadius, 0.0f);
   if (a.maxDt || sc.maxDt) o.estimate.maxTimeDistance = pick(a.maxDt, sc.maxDt, 0.0f);
+  if (a.kernelFootprint) o.kernelFootprint = *a.kernelFootprint;
   o.estimate.spaceKernel = spaceKernelFrom(pick(a.kernelSpace, sc.kernelSpace, std::string("uniform")));
   o.estimate.timeKernel = timeKernelFrom(pick(a.kernelTime, sc.kernelTime, std::string("uniform")));
   o.gatherRays = pick(a.gather, sc.gather, o.gatherRays);
@@ -361,8 +362,14 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
       ->check(CLI::PositiveNumber)->group(photonGroup);
   c->add_option("--max-radius", a.maxRadius, "Largest search radius, scene units (default 2% of the scene's diagonal, the diagonal clipped to 20x the camera's distance to its target)")
       ->check(rangeOf(limits::kMaxRadius))->group(photonGroup);
-  c->add_option("--max-dt", a.maxDt, "twopass: largest time distance kept, seconds (default: none)")
+  c->add_option("--max-dt", a.maxDt, "twopass: largest time distance kept, seconds (default: 10% of the shutter)")
       ->check(CLI::PositiveNumber)->group(photonGroup);
+  c->add_option("--kernel-footprint", a.kernelFootprint,
+                "twopass: the space-time kernel of a caustic estimate seen from the camera is at least this many times "
+                "one eye sample's share of its pixel (pixel area x shutter / spp), growing k_s up to 16x where photons "
+                "bunch; 0: pure k-NN, whose tiny kernels at a focused moving caustic give speckles (default 1, "
+                "docs/photon-map.md)")
+      ->check(CLI::Range(0.0f, 1000.0f))->group(photonGroup);
   c->add_option("--kernel-space", a.kernelSpace, "Space kernel: uniform, cone, epanechnikov (default uniform)")
       ->check(CLI::IsMember({"uniform", "cone", "epanechnikov"}))->group(photonGroup);
   c->add_option("--kernel-time", a.kernelTime, "Time kernel: uniform, epanechnikov (default uniform)")

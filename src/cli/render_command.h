@@ -28,6 +28,7 @@ struct RenderArgs {
   std::optional<std::string> search, kernelSpace, kernelTime;
   std::optional<std::string> sampler;
   std::optional<float> fraction, kappa, maxRadius, maxDt;
+  std::optional<float> kernelFootprint;
   bool globalDirect = false;
   // --resume: the EXR of an earlier progressive render to continue (cli/resume.h).
   std::optional<std::string> resume;

@@ -35,6 +35,18 @@
 //    N = integral of K2 over [a, b] (= b - a for uniform: the volume is
 //    pi r^2 times the window length). See docs/photon-map.md for why the
 //    window is whole bins rather than 2 max |t_p - t| with bin centres.
+//  * Two-pass minimum kernel volume (the eye sample's share of its pixel):
+//    radiance(..., minVolume) asks that the space-time kernel pi r^2 h N be
+//    at least minVolume (scene units^2 x seconds). Where photons bunch (a
+//    focused caustic on a surface moving along its normal) the k_s nearest
+//    fill a ball far smaller than the footprint one eye sample stands for,
+//    and its window, tied to r by the motion, is a few bins: the estimate
+//    resolves structure the eye samples cannot, and the pixel mean becomes
+//    heavy-tailed (docs/photon-map.md, "The estimate's variance"). Such a
+//    query is redone with k_s grown by minVolume / volume (at most
+//    Options::maxGrowth times): the photon count in the kernel grows with its
+//    volume, so the kernel reaches about the footprint and averages what the
+//    sample's neighbours would have averaged anyway.
 #pragma once
 #include <cmath>
 #include <cstdint>
@@ -66,6 +78,9 @@ struct Options {
   float coneK = 1.1f;                              // Jensen's cone filter constant
   TimeKernel timeKernel = TimeKernel::Uniform;     // TimeTwoPass
   float minRadius2 = 1e-12f;  // floor of r^2 (scene units^2), see header
+  // TimeTwoPass with a minimum volume (see header): k_s may grow to at most
+  // maxGrowth x ks for a query whose kernel is smaller than asked.
+  int maxGrowth = 16;
 };
 
 // What an estimate used (tests, debugging). Filling `used` allocates, so
@@ -95,12 +110,14 @@ class Gatherer {
   Gatherer(const photon::KdTree& tree, const Options& options);
   const Options& options() const { return opt_; }
 
+  // minVolume: TimeTwoPass only, the smallest space-time kernel volume
+  // (scene units^2 x seconds) the query should use; 0: none (see header).
   template <class Brdf>
   Rgb radiance(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report = nullptr,
-              uint8_t surfaceTag = photon::kNoSurfaceTag) {
+              uint8_t surfaceTag = photon::kNoSurfaceTag, float minVolume = 0.0f) {
     switch (opt_.method) {
       case Method::Standard: return standard(x, n, wo, brdf, report, surfaceTag);
-      case Method::TimeTwoPass: return timeTwoPass(x, n, wo, t, brdf, report, surfaceTag);
+      case Method::TimeTwoPass: return timeTwoPass(x, n, wo, t, brdf, report, surfaceTag, minVolume);
       case Method::SpaceTime4D: return spaceTime4D(x, n, wo, t, brdf, report, surfaceTag);
     }
     return Rgb(0.0f);
@@ -122,18 +139,18 @@ class Gatherer {
   //      L = 1/(pi r^2 h N) sum f_r Q_p K1(|x_p - x|/r) K2((t_p - t)/h) ----
   template <class Brdf>
   Rgb timeTwoPass(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report = nullptr,
-                  uint8_t surfaceTag = photon::kNoSurfaceTag) {
+                  uint8_t surfaceTag = photon::kNoSurfaceTag, float minVolume = 0.0f) {
     bool epa = opt_.timeKernel == TimeKernel::Epanechnikov;
     switch (opt_.spaceKernel) {
       case SpaceKernel::Uniform:
-        return epa ? twoPassImpl<K2Epanechnikov>(K1Uniform{}, x, n, wo, t, brdf, report, surfaceTag)
-                   : twoPassImpl<K2Uniform>(K1Uniform{}, x, n, wo, t, brdf, report, surfaceTag);
+        return epa ? twoPassImpl<K2Epanechnikov>(K1Uniform{}, x, n, wo, t, brdf, report, surfaceTag, minVolume)
+                   : twoPassImpl<K2Uniform>(K1Uniform{}, x, n, wo, t, brdf, report, surfaceTag, minVolume);
       case SpaceKernel::Epanechnikov:
-        return epa ? twoPassImpl<K2Epanechnikov>(K1Epanechnikov{}, x, n, wo, t, brdf, report, surfaceTag)
-                   : twoPassImpl<K2Uniform>(K1Epanechnikov{}, x, n, wo, t, brdf, report, surfaceTag);
+        return epa ? twoPassImpl<K2Epanechnikov>(K1Epanechnikov{}, x, n, wo, t, brdf, report, surfaceTag, minVolume)
+                   : twoPassImpl<K2Uniform>(K1Epanechnikov{}, x, n, wo, t, brdf, report, surfaceTag, minVolume);
       case SpaceKernel::Cone:
-        return epa ? twoPassImpl<K2Epanechnikov>(K1Cone(opt_.coneK), x, n, wo, t, brdf, report, surfaceTag)
-                   : twoPassImpl<K2Uniform>(K1Cone(opt_.coneK), x, n, wo, t, brdf, report, surfaceTag);
+        return epa ? twoPassImpl<K2Epanechnikov>(K1Cone(opt_.coneK), x, n, wo, t, brdf, report, surfaceTag, minVolume)
+                   : twoPassImpl<K2Uniform>(K1Cone(opt_.coneK), x, n, wo, t, brdf, report, surfaceTag, minVolume);
     }
     return Rgb(0.0f);
   }
@@ -154,7 +171,7 @@ class Gatherer {
   Rgb standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, Report* report, uint8_t surfaceTag);
   template <class K2, class K1, class Brdf>
   Rgb twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report,
-                  uint8_t surfaceTag);
+                  uint8_t surfaceTag, float minVolume);
 
   const photon::KdTree* tree_;
   Options opt_;
@@ -205,38 +222,51 @@ Rgb Gatherer::standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, 
 
 template <class K2, class K1, class Brdf>
 Rgb Gatherer::twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report,
-                          uint8_t surfaceTag) {
+                          uint8_t surfaceTag, float minVolume) {
   const photon::PhotonStore& s = tree_->store();
   const photon::TimeQuantiser& tq = s.time();
-  float maxR2 = opt_.maxRadius * opt_.maxRadius;
-  // ---- pass 1: k_s nearest in space ----
-  int found = tree_->knn(x, opt_.ks, maxR2, query_);
-  if (report) {
-    *report = Report{};
-    report->candidates = found;
+  const float maxR2 = opt_.maxRadius * opt_.maxRadius;
+  const uint16_t* flags = s.flags();
+  const float u = tq.binUnits(t);
+  if (report) *report = Report{};
+  int ks = opt_.ks, found = 0;
+  float r2 = 0.0f, h = 0.0f, invH = 0.0f, volume = 0.0f;
+  uint8_t* bins = nullptr;
+  photon::TimeWindow win;
+  // At most twice: the k_s nearest, then (if the kernel is smaller than
+  // minVolume and the search was not stopped by the maximum radius) again
+  // with k_s grown by the missing volume ratio (see the header comment).
+  for (int attempt = 0;; ++attempt) {
+    // ---- pass 1: k_s nearest in space ----
+    found = tree_->knn(x, ks, maxR2, query_);
+    if (report) report->candidates = found;
+    if (found == 0) return Rgb(0.0f);
+    r2 = ballRadius2(found, ks, maxR2);
+    const uint32_t* idx = query_.index();
+    if (bins_.size() < size_t(found) + photon::kSelectPadding) bins_.resize(size_t(found) + photon::kSelectPadding);
+    if (kept_.size() < size_t(found)) kept_.resize(size_t(found));
+    bins = bins_.data();
+    for (int i = 0; i < found; ++i) bins[i] = uint8_t(flags[idx[i]] & photon::kTimeMask);
+    // ---- pass 2: the fraction f nearest in time (whole bins) ----
+    int keep = photon::keptCount(opt_.fraction, found);
+    win = photon::selectTimeWindow(bins, found, u, keep, opt_.maxTimeDistance * tq.invBinWidth);
+    if (report) report->kept = win.kept;
+    if (win.empty()) return Rgb(0.0f);
+    // ---- the cylinder: disc pi r^2 times the clipped window ----
+    float lo = float(win.lo), hi1 = float(win.hi + 1);
+    h = std::max(u - lo, hi1 - u);  // >= 0.5: u lies in [lo, hi + 1]
+    invH = 1.0f / h;
+    float norm = K2::integral((lo - u) * invH, (hi1 - u) * invH);
+    volume = kPi * r2 * (h * tq.binWidth) * norm;
+    if (attempt > 0 || !(volume < minVolume) || found < ks) break;
+    const int maxKs = opt_.ks * std::max(1, opt_.maxGrowth);
+    const double grown = std::ceil(double(ks) * double(minVolume) / double(volume));
+    int next = grown < double(maxKs) ? int(grown) : maxKs;
+    if (next <= ks) break;
+    ks = next;
   }
-  if (found == 0) return Rgb(0.0f);
-  float r2 = ballRadius2(found, opt_.ks, maxR2);
   const uint32_t* idx = query_.index();
   const float* d2 = query_.dist2();
-  const uint16_t* flags = s.flags();
-  if (bins_.size() < size_t(found) + photon::kSelectPadding) bins_.resize(size_t(found) + photon::kSelectPadding);
-  if (kept_.size() < size_t(found)) kept_.resize(size_t(found));
-  uint8_t* bins = bins_.data();
-  for (int i = 0; i < found; ++i) bins[i] = uint8_t(flags[idx[i]] & photon::kTimeMask);
-  // ---- pass 2: the fraction f nearest in time (whole bins) ----
-  float u = tq.binUnits(t);
-  int keep = photon::keptCount(opt_.fraction, found);
-  photon::TimeWindow win =
-      photon::selectTimeWindow(bins, found, u, keep, opt_.maxTimeDistance * tq.invBinWidth);
-  if (report) report->kept = win.kept;
-  if (win.empty()) return Rgb(0.0f);
-  // ---- the cylinder: disc pi r^2 times the clipped window ----
-  float lo = float(win.lo), hi1 = float(win.hi + 1);
-  float h = std::max(u - lo, hi1 - u);  // >= 0.5: u lies in [lo, hi + 1]
-  float invH = 1.0f / h;
-  float norm = K2::integral((lo - u) * invH, (hi1 - u) * invH);
-  float volume = kPi * r2 * (h * tq.binWidth) * norm;
   const uint16_t* dirs = s.directions();
   const uint32_t* energies = s.energies();
   // Compact the kept candidates without a branch (about half are kept, in

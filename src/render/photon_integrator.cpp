@@ -36,7 +36,8 @@ EstimateCounts PhotonIntegrator::counts() const { return {standardCount_.load(),
 
 Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::Gatherer>& g,
                                std::unique_ptr<estimate::Gatherer>& g3, const Hit& hit, const ShadingContext& ctx,
-                               Vec3f wo, float time01, bool timeDependent, EstimateCounts& counts) const {
+                               Vec3f wo, float time01, bool timeDependent, EstimateCounts& counts,
+                               float minVolume) const {
   if (!map || map->size() == 0) return Rgb(0.0f);
   auto brdf = [&ctx](Vec3f wi, Vec3f) { return bsdfEval(ctx, wi); };
   Vec3f n = ctx.frame.n;  // faces the viewer: photons from the other side do not count
@@ -52,7 +53,7 @@ Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::G
       g = std::make_unique<estimate::Gatherer>(map->tree, o);
     }
     float t = scene_.shutter.instant() ? map->store.t0() : scene_.shutter.fromNormalized(time01);
-    return g->radiance(hit.p, n, wo, t, brdf, nullptr, tag);
+    return g->radiance(hit.p, n, wo, t, brdf, nullptr, tag, minVolume);
   }
   ++counts.standard;
   if (!g3) {
@@ -117,12 +118,14 @@ Rgb PhotonIntegrator::radiance(Vec3f origin, Vec3f dir, float time01, Stream& sa
   // the fixed-point time average, so always the time-dependent estimate.
   bool touched = scene_.camera.moving();
   bool lastDelta = true;
+  float pathLength = 0.0f;  // from the camera, through mirrors and glass: the pixel footprint grows with it
   for (int depth = 0; depth < s_.maxDepth; ++depth) {
     Hit hit;
     if (!scene_.intersect(origin, dir, kInf, time01, hit)) {
       L += beta * scene_.background;
       break;
     }
+    pathLength += hit.t;
     touched = touched || scene_.segmentMeetsMotion(origin, dir, hit.t);
     if (hit.isLight()) {
       // Seen directly or through mirrors/glass only: shadow rays cannot.
@@ -144,7 +147,8 @@ Rgb PhotonIntegrator::radiance(Vec3f origin, Vec3f dir, float time01, Stream& sa
       }
       bool gather = global_ && global_->size() > 0 && s_.gatherRays > 0;
       L += beta * directLight(scene_, hit, ctx, time01, sampler, depth, gather ? s_.gatherRays : 0);
-      L += beta * estimate(caustic_, ts.caustic, ts.caustic3, hit, ctx, -dir, time01, timeDependent, ts.counts);
+      L += beta * estimate(caustic_, ts.caustic, ts.caustic3, hit, ctx, -dir, time01, timeDependent, ts.counts,
+                           s_.footprintVolume * pathLength * pathLength);
       if (gather) L += beta * finalGather(hit, ctx, time01, touched, sampler, depth, ts);
       break;
     }

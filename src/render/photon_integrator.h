@@ -29,6 +29,11 @@ struct PhotonIntegratorSettings {
   int gatherRays = 1;             // final-gather rays per eye sample
   bool visualizeGlobal = false;   // gather point = global-map estimate alone (no direct, no gather)
   int maxDepth = 16;
+  // Time-dependent two-pass caustic estimates seen from the camera: the
+  // smallest kernel volume is footprintVolume x (eye path length)^2, the
+  // space-time share of one eye sample (pixel area at that distance x
+  // shutter / spp, times a scale); 0: none. See estimate/estimators.h.
+  float footprintVolume = 0.0f;
 };
 
 struct EstimateCounts {
@@ -59,7 +64,7 @@ class PhotonIntegrator {
  private:
   Rgb estimate(const PhotonMap* map, std::unique_ptr<estimate::Gatherer>& g, std::unique_ptr<estimate::Gatherer>& g3,
                const Hit& hit, const struct ShadingContext& ctx, Vec3f wo, float time01, bool timeDependent,
-               EstimateCounts& counts) const;
+               EstimateCounts& counts, float minVolume = 0.0f) const;
   template <class Stream>
   Rgb finalGather(const Hit& hit, const struct ShadingContext& ctx, float time01, bool touched, Stream& sampler,
                   int vertex, ThreadState& ts) const;

@@ -255,6 +255,14 @@ PhotonIntegratorSettings integratorSettings(const Scene& scene, const RenderOpti
   s.estimate = opt.estimate;
   s.estimate.maxRadius = defaultMaxRadius(scene, opt);
   if (!std::isfinite(s.estimate.maxTimeDistance)) s.estimate.maxTimeDistance = opt.maxDtFraction * scene.shutter.length();
+  // One eye sample's share of its pixel in space-time, per unit path length
+  // squared: (angle of a pixel)^2 x shutter / spp, times the scale.
+  Vec3f o, d0, d1;
+  float cx = 0.5f * float(scene.camera.width()), cy = 0.5f * float(scene.camera.height());
+  scene.camera.generateRay({cx, cy}, 0.5f, o, d0);
+  scene.camera.generateRay({cx + 1.0f, cy}, 0.5f, o, d1);
+  float pixelAngle = length(cross(d0, d1)) / (length(d0) * length(d1));
+  s.footprintVolume = opt.kernelFootprint * pixelAngle * pixelAngle * scene.shutter.length() / float(std::max(1, opt.spp));
   s.gatherRays = opt.gatherRays;
   s.visualizeGlobal = opt.visualizeGlobal;
   s.maxDepth = opt.maxDepth;

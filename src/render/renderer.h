@@ -57,6 +57,12 @@ struct RenderOptions {
   // nearest-in-time estimate decays only as k f / (2 dt) away from a moving
   // caustic, and those tails smear a sharp spot (Delta t_max of method.md).
   float maxDtFraction = 0.1f;
+  // Two-pass time estimate seen from the camera: its space-time kernel is
+  // at least this many times one eye sample's share of its pixel (pixel
+  // area at the path's length x shutter / spp); 0: pure k-NN. A smaller
+  // kernel resolves what the eye samples cannot, and the image turns
+  // heavy-tailed (docs/photon-map.md, "The estimate's variance").
+  float kernelFootprint = 1.0f;
   int gatherRays = 1;
   bool visualizeGlobal = false;
   // How the user set the two photon counts, for the memory-budget error:
