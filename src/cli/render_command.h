@@ -26,6 +26,10 @@ struct RenderArgs {
   std::optional<std::string> sampler;
   std::optional<float> fraction, kappa, maxRadius, maxDt;
   bool globalDirect = false;
+  // animations (scenes with an "animation" block, cli/animation_command.h)
+  std::optional<std::string> frameRange, video;
+  std::optional<int> window;
+  bool independentFrames = false;
   int threads = 0;  // 0: all cores
   bool quiet = false;
   bool stats = false;  // --stats: memory, photon and timing figures after the summary

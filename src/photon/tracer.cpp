@@ -312,6 +312,7 @@ struct Tracer {
   LightTable lights;
   float t0, t1, ts;
   uint32_t timeScramble;
+  float u0 = 0.0f, u1 = 1.0f;  // path times, normalised over the scene's shutter
 
   // Traces paths [first, first + count) of batch `b` into `out`, energies
   // scaled by `energyScale` (= ts / n_e). Returns nothing: out grows.
@@ -325,7 +326,8 @@ struct Tracer {
       uint64_t g = b * kPathsPerBatch + i;
       // The time stays the scrambled van der Corput of the path index for
       // both kinds: it is already a stratified 1D sequence over the shutter.
-      float time01 = settings.spreadInTime ? scrambledVanDerCorput(uint32_t(g), timeScramble) : settings.fixedTime01;
+      float time01 = settings.spreadInTime ? u0 + scrambledVanDerCorput(uint32_t(g), timeScramble) * (u1 - u0)
+                                            : settings.fixedTime01;
       if (settings.sampler == SamplerKind::Sobol) {
         SobolStream s{sobolSeed, uint32_t(g)};
         rays += tracePath(time01, s, energyScale, out);
@@ -434,13 +436,25 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   TraceResult result;
   float t0, t1;
   photonTimeRange(scene, t0, t1);
+  float ts = t1 - t0, u0 = 0.0f, u1 = 1.0f;
+  if (std::isfinite(settings.timeOpen)) {  // a segment of an animation's timeline
+    ts = settings.timeClose - settings.timeOpen;
+    u0 = scene.shutter.normalized(settings.timeOpen);
+    u1 = scene.shutter.normalized(settings.timeClose);
+    t0 = settings.timeOpen;
+    t1 = settings.timeClose;
+  }
+  if (std::isfinite(settings.storeT0)) {
+    t0 = settings.storeT0;
+    t1 = settings.storeT1;
+  }
   result.store = PhotonStore(t0, t1);
   std::vector<Target> targets;
   if (settings.kind == MapKind::Caustic) targets = specularTargets(scene);
   Tracer tracer{scene, settings, targets,
                 makeLightTable(scene, settings.kind == MapKind::Caustic && settings.projection ? &targets : nullptr), t0,
-                t1, t1 - t0,
-                uint32_t(mix64(settings.seed ^ 0x7173ull))};
+                t1, ts,
+                uint32_t(mix64(settings.seed ^ 0x7173ull)), u0, u1};
   if (settings.storedWanted == 0 || tracer.lights.empty()) return result;
   if (settings.kind == MapKind::Caustic && !sceneHasSpecular(scene)) return result;
   const char* stage = settings.kind == MapKind::Caustic ? "caustic photons" : "global photons";
@@ -452,6 +466,7 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   size_t stored = 0;
   uint64_t pilotRays = 0;
   for (;;) {
+    if (settings.storedPerPath > 0) break;  // measured before
     uint64_t rays = 0;
     PhotonStore pilot = tracer.traceBatches(pilotBatches, 1.0, Progress{}, stage, 0, &rays);
     pilotRays += rays;
@@ -463,7 +478,7 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
     if (next <= pilotBatches) break;
     pilotBatches = next;
   }
-  if (stored == 0) {
+  if (stored == 0 && !(settings.storedPerPath > 0)) {
     // Zero of n: the rate is below 3 / n at 95% confidence.
     uint64_t paths = pilotBatches * kPathsPerBatch;
     result.rays = pilotRays;
@@ -473,7 +488,9 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
                      std::to_string(paths / 3) + " would (95% confidence); the map is empty";
     return result;
   }
-  double perPath = double(stored) / double(pilotBatches * kPathsPerBatch);
+  double perPath = settings.storedPerPath > 0 ? settings.storedPerPath
+                                              : double(stored) / double(pilotBatches * kPathsPerBatch);
+  result.storedPerPath = perPath;
   double pathsNeeded = double(settings.storedWanted) / perPath;
   double pathsCap = kMaxPathsPerPhoton * double(settings.storedWanted);
   if (pathsNeeded > pathsCap) {
