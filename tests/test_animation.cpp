@@ -216,9 +216,12 @@ TEST_CASE("animation time grid: shutters on bin edges, maps within 256 bins, the
       CHECK(g.shutterBins >= 40);  // fine enough in time (>= 40 bins per shutter)
     }
   }
-  // 180 degrees: 213 shutter bins of 426 per frame, pads of 23.
-  TimeGrid g = makeTimeGrid(scene::AnimationDesc{24.0, 48, 180.0}, 0.1);
-  CHECK(g.shutterBins * 2 == g.binsPerFrame);
+  // 180 degrees, the default reach: 210 shutter bins of 420 per frame,
+  // pads of 23 (docs/animation.md).
+  TimeGrid g = makeTimeGrid(scene::AnimationDesc{24.0, 48, 180.0}, double(RenderOptions{}.maxDtFraction));
+  CHECK(g.binsPerFrame == 420);
+  CHECK(g.shutterBins == 210);
+  CHECK(g.padBins == 23);
 }
 
 TEST_CASE("animation: frames of the moving plane match the analytic irradiance, and the frame rendered alone") {
