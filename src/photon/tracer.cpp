@@ -73,11 +73,31 @@ struct Target {
   float radius;
 };
 
-std::vector<Target> specularTargets(const Scene& scene) {
+// World bounds of an object over normalised times [u0, u1]: the blended
+// motion moves every point linearly between steps, so the bounds at u0, u1
+// and the steps between them hold it all (as Motion::sweptBounds).
+Bounds3f boundsOver(const SceneObject& o, float u0, float u1) {
+  if (!o.motion.moving() || (u0 <= 0.0f && u1 >= 1.0f)) return o.sweptBounds;
+  Bounds3f b = transformBounds(o.motion.atNormalized(u0), o.objectBounds);
+  b.extend(transformBounds(o.motion.atNormalized(u1), o.objectBounds));
+  const int n = o.motion.stepCount();
+  for (int i = 1; i + 1 < n; ++i) {
+    float u = float(i) / float(n - 1);
+    if (u > u0 && u < u1) b.extend(transformBounds(o.motion.step(i), o.objectBounds));
+  }
+  return b;
+}
+
+// Targets over the paths' times [u0, u1] (normalised): a segment of an
+// animation's timeline aims at where the objects are then, not at the
+// whole timeline's sweep.
+std::vector<Target> specularTargets(const Scene& scene, float u0 = 0.0f, float u1 = 1.0f) {
   std::vector<Target> t;
   for (const SceneObject& o : scene.objects)
-    if (scene.materials[o.material].isDeltaOnly())
-      t.push_back({o.sweptBounds.center(), 0.5f * length(o.sweptBounds.diagonal()) * 1.001f});
+    if (scene.materials[o.material].isDeltaOnly()) {
+      Bounds3f b = boundsOver(o, u0, u1);
+      t.push_back({b.center(), 0.5f * length(b.diagonal()) * 1.001f});
+    }
   return t;
 }
 
@@ -450,7 +470,7 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   }
   result.store = PhotonStore(t0, t1);
   std::vector<Target> targets;
-  if (settings.kind == MapKind::Caustic) targets = specularTargets(scene);
+  if (settings.kind == MapKind::Caustic) targets = specularTargets(scene, u0, u1);
   Tracer tracer{scene, settings, targets,
                 makeLightTable(scene, settings.kind == MapKind::Caustic && settings.projection ? &targets : nullptr), t0,
                 t1, ts,

@@ -32,8 +32,7 @@ struct Segment {
 
 struct Kind {
   photon::MapKind kind;
-  size_t perShutter;     // photons wanted per frame's shutter time
-  double storedPerPath;  // the pilot's rate over the whole timeline; 0: nothing to trace
+  size_t perShutter;  // photons wanted per frame's shutter time
 };
 
 // The grid's cut points that matter for frames [first, last]: the ends of
@@ -166,29 +165,35 @@ AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& a
   framed.report = [&](const std::string& stage, size_t done, size_t all) { progress(prefix + stage, done, all); };
   framed.position = progress.position;
 
-  // Pilot: stored photons per path over the whole timeline, once, so that
-  // every segment's emission is sized alike whatever frames a run renders.
   std::vector<Kind> kinds;
-  Timer pilotTimer;
-  if (photons) {
+  if (photons)
     for (auto [kind, count] : {std::pair{photon::MapKind::Caustic, opt.causticPhotons},
-                               std::pair{photon::MapKind::Global, wantGlobal ? opt.globalPhotons : size_t(0)}}) {
-      Kind k{kind, count, 0.0};
-      if (count > 0) {
-        photon::TraceSettings ts;
-        ts.kind = kind;
-        ts.storedWanted = 1;
-        ts.seed = hashCombine(opt.seed, 0x9170ull);
-        ts.maxBounces = opt.maxDepth;
-        ts.sampler = opt.sampler;
-        photon::TraceResult r = photon::tracePhotons(scene, ts, Progress{});
-        k.storedPerPath = r.storedPerPath;
-        if (!r.warning.empty()) stats.warnings.push_back(r.warning);
-      }
-      kinds.push_back(k);
-    }
-  }
-  stats.photonSeconds += pilotTimer.seconds();
+                               std::pair{photon::MapKind::Global, wantGlobal ? opt.globalPhotons : size_t(0)}})
+      kinds.push_back(Kind{kind, count});
+  // Pilot: stored photons per path, once per frame period and kind, over
+  // that frame's time map (the caustic map aims at where the specular
+  // objects are then). Segments of the period size their emission by it,
+  // so a frame's photons do not depend on the range or window of the run.
+  const int64_t timelineEnd = int64_t(anim.frames) * grid.binsPerFrame;
+  std::map<std::pair<int64_t, int>, double> rates;
+  auto rateFor = [&](int64_t period, const Kind& kd) {
+    auto key = std::pair{period, int(kd.kind)};
+    auto it = rates.find(key);
+    if (it != rates.end()) return it->second;
+    photon::TraceSettings ts;
+    ts.kind = kd.kind;
+    ts.storedWanted = 1;
+    ts.seed = hashCombine(opt.seed, 0x9170ull, uint64_t(period));
+    ts.maxBounces = opt.maxDepth;
+    ts.sampler = opt.sampler;
+    int frame = int(std::clamp<int64_t>(period, 0, anim.frames - 1));
+    ts.timeOpen = float(double(std::max<int64_t>(0, grid.mapLo(frame))) * grid.binWidth);
+    ts.timeClose = float(double(std::min(timelineEnd, grid.mapHi(frame))) * grid.binWidth);
+    photon::TraceResult r = photon::tracePhotons(scene, ts, Progress{});
+    if (!r.warning.empty() && std::find(stats.warnings.begin(), stats.warnings.end(), r.warning) == stats.warnings.end())
+      stats.warnings.push_back(r.warning);
+    return rates[key] = r.storedPerPath;
+  };
 
   const std::vector<int64_t> cuts = cutPoints(grid, anim.frames, ao.first, ao.last);
   std::map<int64_t, Segment> held;  // by lo
@@ -214,8 +219,11 @@ AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& a
         // (--independent-frames: by the segment's absolute place instead).
         int64_t phase = lo % grid.binsPerFrame;
         uint64_t key = ao.independentFrames ? uint64_t(lo) | (uint64_t(1) << 62) : uint64_t(phase);
+        const int64_t period = std::clamp<int64_t>((lo + grid.padBins) / grid.binsPerFrame, 0, anim.frames - 1);
         for (const Kind& kd : kinds) {
-          if (!(kd.storedPerPath > 0)) continue;
+          if (kd.perShutter == 0) continue;
+          double rate = rateFor(period, kd);
+          if (!(rate > 0)) continue;
           photon::TraceSettings ts;
           ts.kind = kd.kind;
           double share = double(hi - lo) / (double(grid.binsPerFrame) * anim.shutterAngle / 360.0);
@@ -227,7 +235,7 @@ AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& a
           ts.timeClose = float(double(hi) * grid.binWidth);
           ts.storeT0 = ts.timeOpen;
           ts.storeT1 = float(double(lo + photon::kTimeBins) * grid.binWidth);
-          ts.storedPerPath = kd.storedPerPath;
+          ts.storedPerPath = rate;
           photon::TraceResult r = photon::tracePhotons(scene, ts, framed);
           if (!r.warning.empty() && std::find(stats.warnings.begin(), stats.warnings.end(), r.warning) == stats.warnings.end())
             stats.warnings.push_back(r.warning);
