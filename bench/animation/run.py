@@ -50,9 +50,10 @@ def main():
     ap.add_argument("--photons", type=int, default=20000)
     ap.add_argument("--global-photons", type=int, default=5000)
     ap.add_argument("--ref-mult", type=int, default=8)
-    ap.add_argument("--crop", required=True)
+    ap.add_argument("--crop", required=True, action="append", help="X,Y,W,H; repeat for several regions")
     ap.add_argument("--out", default="/tmp/bench-anim")
-    ap.add_argument("--skip-ref", action="store_true")
+    ap.add_argument("--skip-ref", action="store_true", help="reuse the reference of an earlier run in --out")
+    ap.add_argument("--metrics-only", action="store_true", help="render nothing: measure the images already in --out")
     a = ap.parse_args()
     out = a.out
     os.makedirs(out, exist_ok=True)
@@ -66,39 +67,40 @@ def main():
     common = ["--resolution", a.res, "-t", "2", "-q"]
     seq_args = common + ["--spp", str(a.spp), "--photons", str(a.photons), "--global-photons", str(a.global_photons)]
     times = {}
-    if not a.skip_ref:
-        times["ref"] = cpu_run([TDPM, "render", a.scene, "-o", out + "/ref/f_####.exr", "--frame-range", rng, "--seed", "99",
-                                "--spp", str(4 * a.spp), "--photons", str(a.ref_mult * a.photons),
-                                "--global-photons", str(a.ref_mult * a.global_photons)] + common)
-    times["seq"] = cpu_run([TDPM, "render", a.scene, "-o", out + "/seq/f_####.exr", "--frame-range", rng] + seq_args)
-    times["ind"] = cpu_run([TDPM, "render", a.scene, "-o", out + "/ind/f_####.exr", "--frame-range", rng,
-                            "--independent-frames"] + seq_args)
-    subprocess.run([sys.executable, os.path.join(ROOT, "bench", "animation", "single_frames.py"), a.scene, single,
-                    str(a.first), str(a.last)], check=True)
-    for variant, seed in (("sep", None), ("same", 1)):
-        os.makedirs(out + "/" + variant, exist_ok=True)
-        total = 0.0
-        for i in frames:
-            s = str(1000 + i) if seed is None else str(seed)
-            total += cpu_run([TDPM, "render", "%s/frame_%04d.json" % (single, i), "-o",
-                              "%s/%s/f_%04d.exr" % (out, variant, i), "--seed", s] + seq_args)
-        times[variant] = total
+    if not a.metrics_only:
+        if not a.skip_ref:
+            times["ref"] = cpu_run([TDPM, "render", a.scene, "-o", out + "/ref/f_####.exr", "--frame-range", rng,
+                                    "--seed", "99", "--spp", str(4 * a.spp), "--photons", str(a.ref_mult * a.photons),
+                                    "--global-photons", str(a.ref_mult * a.global_photons)] + common)
+        times["seq"] = cpu_run([TDPM, "render", a.scene, "-o", out + "/seq/f_####.exr", "--frame-range", rng] + seq_args)
+        times["ind"] = cpu_run([TDPM, "render", a.scene, "-o", out + "/ind/f_####.exr", "--frame-range", rng,
+                                "--independent-frames"] + seq_args)
+        subprocess.run([sys.executable, os.path.join(ROOT, "bench", "animation", "single_frames.py"), a.scene, single,
+                        str(a.first), str(a.last)], check=True)
+        for variant, seed in (("sep", None), ("same", 1)):
+            os.makedirs(out + "/" + variant, exist_ok=True)
+            total = 0.0
+            for i in frames:
+                s = str(1000 + i) if seed is None else str(seed)
+                total += cpu_run([TDPM, "render", "%s/frame_%04d.json" % (single, i), "-o",
+                                  "%s/%s/f_%04d.exr" % (out, variant, i), "--seed", s] + seq_args)
+            times[variant] = total
     print("scene %s frames %s at %s, spp %d, photons %d + %d global per frame; reference x%d photons, x4 spp"
           % (a.scene, rng, a.res, a.spp, a.photons, a.global_photons, a.ref_mult))
-    ref_flicker = []
-    for i in frames[:-1]:
-        ref_flicker.append(compare("%s/ref/f_%04d.exr" % (out, i + 1), "%s/ref/f_%04d.exr" % (out, i), a.crop)["rmse"]["overall"])
-    print("reference flicker in crop %s: %.5f" % (a.crop, sum(ref_flicker) / len(ref_flicker)))
-    print("%-5s %10s %12s %14s %12s %12s" % ("", "CPU s", "relMSE mean", "relMSE median", "relMSE crop", "flicker"))
-    for v in ("seq", "ind", "sep", "same"):
-        rel = [compare("%s/%s/f_%04d.exr" % (out, v, i), "%s/ref/f_%04d.exr" % (out, i))["rel_mse"]["overall"] for i in frames]
-        relc = [compare("%s/%s/f_%04d.exr" % (out, v, i), "%s/ref/f_%04d.exr" % (out, i), a.crop)["rel_mse"]["overall"]
-                for i in frames]
-        fl = [compare("%s/%s/f_%04d.exr" % (out, v, i + 1), "%s/%s/f_%04d.exr" % (out, v, i), a.crop)["rmse"]["overall"]
-              for i in frames[:-1]]
-        med = sorted(rel)[len(rel) // 2]
-        print("%-5s %10.2f %12.6f %14.6f %12.6f %12.5f" % (v, times.get(v, float("nan")), sum(rel) / len(rel), med,
-                                                         sum(relc) / len(relc), sum(fl) / len(fl)))
-
+    for crop in a.crop:
+        ref_flicker = [compare("%s/ref/f_%04d.exr" % (out, i + 1), "%s/ref/f_%04d.exr" % (out, i), crop)["rmse"]["overall"]
+                       for i in frames[:-1]]
+        print("crop %s: reference flicker %.5f" % (crop, sum(ref_flicker) / len(ref_flicker)))
+        print("%-5s %10s %12s %14s %12s %12s" % ("", "CPU s", "relMSE mean", "relMSE median", "relMSE crop", "flicker"))
+        for v in ("seq", "ind", "sep", "same"):
+            rel = [compare("%s/%s/f_%04d.exr" % (out, v, i), "%s/ref/f_%04d.exr" % (out, i))["rel_mse"]["overall"]
+                   for i in frames]
+            relc = [compare("%s/%s/f_%04d.exr" % (out, v, i), "%s/ref/f_%04d.exr" % (out, i), crop)["rel_mse"]["overall"]
+                    for i in frames]
+            fl = [compare("%s/%s/f_%04d.exr" % (out, v, i + 1), "%s/%s/f_%04d.exr" % (out, v, i), crop)["rmse"]["overall"]
+                  for i in frames[:-1]]
+            med = sorted(rel)[len(rel) // 2]
+            print("%-5s %10.2f %12.6f %14.6f %12.6f %12.5f" % (v, times.get(v, float("nan")), sum(rel) / len(rel), med,
+                                                             sum(relc) / len(relc), sum(fl) / len(fl)))
 
 main()
