@@ -342,7 +342,7 @@ TEST_CASE("scene parse: required keys, unknown keys, wrong types") {
   checkEdit([](Json& j) { j.erase("camera"); }, "top level", "missing required key \"camera\"");
   checkEdit([](Json& j) { j.erase("objects"); }, "top level", "missing required key \"objects\"");
   checkEdit([](Json& j) { j["objets"] = Json::array(); }, "objets",
-            "unknown key \"objets\" (did you mean \"objects\"?); allowed keys: background, camera, lights, "
+            "unknown key \"objets\" (did you mean \"objects\"?); allowed keys: animation, background, camera, lights, "
             "materials, objects, render");
   checkEdit([](Json& j) { j["camera"]["positon"] = {0, 0, 0}; }, "camera.positon",
             "unknown key \"positon\" (did you mean \"position\"?); allowed keys: fov, motion, position, resolution, "

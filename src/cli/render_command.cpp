@@ -13,6 +13,8 @@
 #include <sstream>
 #include <vector>
 
+#include "cli/animation_command.h"
+#include "cli/frame_pattern.h"
 #include "cli/progress_bar.h"
 #include "cli/resume.h"
 #include "core/atomic_file.h"
@@ -378,6 +380,18 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
       ->check(rangeOf(limits::kGather))->group(photonGroup);
   c->add_flag("--global-direct", a.globalDirect, "Show the global photon map directly at the first diffuse hit (debugging, tests)")
       ->group(photonGroup);
+  const std::string animationGroup = "Animations (scenes with an \"animation\" block, docs/animation.md)";
+  c->add_option("--frame-range", a.frameRange, "Frames to render, A-B (from 0, inclusive) (default: all); with -o "
+                "out/frame_####.exr each run of # becomes the zero-padded frame number (default <scene name>_####.exr), "
+                "and the output directory is created")->group(animationGroup);
+  c->add_option("--video", a.video, "Also assemble the frames' PNG previews into this .mp4 or .gif with ffmpeg "
+                "(must be on PATH; checked before rendering)")->group(animationGroup);
+  c->add_option("--window", a.window, "Frames whose photons are traced and held at once (default 4): memory stays "
+                "bounded however many frames; --photons counts per frame's shutter time")
+      ->check(CLI::Range(1, 100000))->group(animationGroup);
+  c->add_flag("--independent-frames", a.independentFrames, "Seed every frame's photons independently (default: "
+              "corresponding photon paths of every frame share random numbers, so still lighting does not flicker)")
+      ->group(animationGroup);
   return c;
 }
 
@@ -399,6 +413,7 @@ int runRender(const RenderArgs& a) {
   // The --progressive flag of issue 10 enables this (and --resume): at merge,
   // `= a.progressive`.
   const bool progressive = false;
+  const bool framePattern = hasFramePlaceholder(a.output);
   try {
   if (a.method && !isRenderMethod(*a.method))
     throw Error("--method: unknown method '" + *a.method + "' (expected " + methodList() + ")");
@@ -406,7 +421,8 @@ int runRender(const RenderArgs& a) {
   int width = 0, height = 0;
   if (a.resolution) parseResolution(*a.resolution, width, height);
   // A pbrt scene names its own output (Film "filename"), known only once it is read.
-  if (comm.root() && (!pbrtScene || !a.output.empty())) validateOutput(output, preview, a.scene);
+  // A frame pattern (out/frame_####.exr) is checked once the frames are known.
+  if (comm.root() && (!pbrtScene || !a.output.empty()) && !framePattern) validateOutput(output, preview, a.scene);
 
   if (pbrtScene) {
     pbrt::ImportResult imported = pbrt::importPbrtFile(a.scene);
@@ -424,11 +440,13 @@ int runRender(const RenderArgs& a) {
   dist::testFailurePoint(comm, "load");
   if (a.kappa) {
     // The usable kappa depends on the scene's shutter (scene/limits.h).
-    limits::KappaRange r = limits::kappaRange(double(desc.camera.shutterClose) - desc.camera.shutterOpen);
+    const double shutterLength = desc.animation ? desc.animation->shutterLength()
+                                                : double(desc.camera.shutterClose) - desc.camera.shutterOpen;
+    limits::KappaRange r = limits::kappaRange(shutterLength);
     if (!(*a.kappa >= r.lo && *a.kappa <= r.hi)) {
       char msg[200];
       std::snprintf(msg, sizeof msg, "--kappa: %g cannot be used with the %g s shutter of ", double(*a.kappa),
-                    double(desc.camera.shutterClose) - desc.camera.shutterOpen);
+                    shutterLength);
       throw Error(msg + a.scene + ": the 4D metric needs kappa in [" + formatG(r.lo) + ", " + formatG(r.hi) +
                   "] (float range)");
     }
@@ -459,6 +477,15 @@ int runRender(const RenderArgs& a) {
   // updates it and the output EXR carries it (docs/resume.md).
   ProgressiveState progressiveState;
   if (progressive) progressiveState = initialProgressiveState(a.resume ? &*a.resume : nullptr, desc, opt);
+
+  if (desc.animation) return runAnimation(a, desc, opt, exposure);
+  if (framePattern || a.frameRange || a.video || a.window || a.independentFrames)
+    throw Error(std::string(framePattern ? "--output: a frame-number pattern (#)"
+                            : a.frameRange ? "--frame-range"
+                            : a.video      ? "--video"
+                            : a.window     ? "--window"
+                                           : "--independent-frames") +
+                " needs an animation, but " + a.scene + " has no \"animation\" block (docs/scene-format.md)");
 
   ThreadLimit limit(a.threads);
   // Under mpirun a rank's stderr is a pipe even on a terminal, but Open MPI

@@ -32,6 +32,10 @@ struct RenderArgs {
   bool globalDirect = false;
   // --resume: the EXR of an earlier progressive render to continue (cli/resume.h).
   std::optional<std::string> resume;
+  // animations (scenes with an "animation" block, cli/animation_command.h)
+  std::optional<std::string> frameRange, video;
+  std::optional<int> window;
+  bool independentFrames = false;
   int threads = 0;  // 0: all cores
   bool quiet = false;
   bool stats = false;  // --stats: memory, photon and timing figures after the summary

@@ -73,11 +73,31 @@ struct Target {
   float radius;
 };
 
-std::vector<Target> specularTargets(const Scene& scene) {
+// World bounds of an object over normalised times [u0, u1]: the blended
+// motion moves every point linearly between steps, so the bounds at u0, u1
+// and the steps between them hold it all (as Motion::sweptBounds).
+Bounds3f boundsOver(const SceneObject& o, float u0, float u1) {
+  if (!o.motion.moving() || (u0 <= 0.0f && u1 >= 1.0f)) return o.sweptBounds;
+  Bounds3f b = transformBounds(o.motion.atNormalized(u0), o.objectBounds);
+  b.extend(transformBounds(o.motion.atNormalized(u1), o.objectBounds));
+  const int n = o.motion.stepCount();
+  for (int i = 1; i + 1 < n; ++i) {
+    float u = float(i) / float(n - 1);
+    if (u > u0 && u < u1) b.extend(transformBounds(o.motion.step(i), o.objectBounds));
+  }
+  return b;
+}
+
+// Targets over the paths' times [u0, u1] (normalised): a segment of an
+// animation's timeline aims at where the objects are then, not at the
+// whole timeline's sweep.
+std::vector<Target> specularTargets(const Scene& scene, float u0 = 0.0f, float u1 = 1.0f) {
   std::vector<Target> t;
   for (const SceneObject& o : scene.objects)
-    if (scene.materials[o.material].isDeltaOnly())
-      t.push_back({o.sweptBounds.center(), 0.5f * length(o.sweptBounds.diagonal()) * 1.001f});
+    if (scene.materials[o.material].isDeltaOnly()) {
+      Bounds3f b = boundsOver(o, u0, u1);
+      t.push_back({b.center(), 0.5f * length(b.diagonal()) * 1.001f});
+    }
   return t;
 }
 
@@ -312,6 +332,7 @@ struct Tracer {
   LightTable lights;
   float t0, t1, ts;
   uint32_t timeScramble;
+  float u0 = 0.0f, u1 = 1.0f;  // path times, normalised over the scene's shutter
 
   // Traces paths [first, first + count) of batch `b` into `out`, energies
   // scaled by `energyScale` (= ts / n_e). Returns nothing: out grows.
@@ -325,7 +346,8 @@ struct Tracer {
       uint64_t g = b * kPathsPerBatch + i;
       // The time stays the scrambled van der Corput of the path index for
       // both kinds: it is already a stratified 1D sequence over the shutter.
-      float time01 = settings.spreadInTime ? scrambledVanDerCorput(uint32_t(g), timeScramble) : settings.fixedTime01;
+      float time01 = settings.spreadInTime ? u0 + scrambledVanDerCorput(uint32_t(g), timeScramble) * (u1 - u0)
+                                            : settings.fixedTime01;
       if (settings.sampler == SamplerKind::Sobol) {
         SobolStream s{sobolSeed, uint32_t(g)};
         rays += tracePath(time01, s, energyScale, out);
@@ -460,13 +482,25 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   TraceResult result;
   float t0, t1;
   photonTimeRange(scene, t0, t1);
+  float ts = t1 - t0, u0 = 0.0f, u1 = 1.0f;
+  if (std::isfinite(settings.timeOpen)) {  // a segment of an animation's timeline
+    ts = settings.timeClose - settings.timeOpen;
+    u0 = scene.shutter.normalized(settings.timeOpen);
+    u1 = scene.shutter.normalized(settings.timeClose);
+    t0 = settings.timeOpen;
+    t1 = settings.timeClose;
+  }
+  if (std::isfinite(settings.storeT0)) {
+    t0 = settings.storeT0;
+    t1 = settings.storeT1;
+  }
   result.store = PhotonStore(t0, t1);
   std::vector<Target> targets;
-  if (settings.kind == MapKind::Caustic) targets = specularTargets(scene);
+  if (settings.kind == MapKind::Caustic) targets = specularTargets(scene, u0, u1);
   Tracer tracer{scene, settings, targets,
                 makeLightTable(scene, settings.kind == MapKind::Caustic && settings.projection ? &targets : nullptr), t0,
-                t1, t1 - t0,
-                uint32_t(mix64(settings.seed ^ 0x7173ull))};
+                t1, ts,
+                uint32_t(mix64(settings.seed ^ 0x7173ull)), u0, u1};
   if (settings.storedWanted == 0 || tracer.lights.empty()) return result;
   if (settings.kind == MapKind::Caustic && !sceneHasSpecular(scene)) return result;
   const char* stage = settings.kind == MapKind::Caustic ? "caustic photons" : "global photons";
@@ -481,6 +515,7 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   size_t stored = 0;
   uint64_t pilotRays = 0;
   for (;;) {
+    if (settings.storedPerPath > 0) break;  // measured before
     uint64_t rays = 0, lo = 0, hi = 0;
     dist::blockRange(pilotBatches, comm.rank(), comm.size(), lo, hi);
     PhotonStore pilot = tracer.traceBatches(lo, hi, 1.0, Progress{}, stage, 0, &rays);
@@ -496,7 +531,7 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
     if (next <= pilotBatches) break;
     pilotBatches = next;
   }
-  if (stored == 0) {
+  if (stored == 0 && !(settings.storedPerPath > 0)) {
     // Zero of n: the rate is below 3 / n at 95% confidence.
     uint64_t paths = pilotBatches * kPathsPerBatch;
     result.rays = pilotRays;
@@ -506,7 +541,9 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
                      std::to_string(paths / 3) + " would (95% confidence); the map is empty";
     return result;
   }
-  double perPath = double(stored) / double(pilotBatches * kPathsPerBatch);
+  double perPath = settings.storedPerPath > 0 ? settings.storedPerPath
+                                              : double(stored) / double(pilotBatches * kPathsPerBatch);
+  result.storedPerPath = perPath;
   double pathsNeeded = double(settings.storedWanted) / perPath;
   double pathsCap = kMaxPathsPerPhoton * double(settings.storedWanted);
   if (pathsNeeded > pathsCap) {

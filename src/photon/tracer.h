@@ -10,6 +10,7 @@
 // batch order, so the maps are identical for any thread count.
 #pragma once
 #include <cstdint>
+#include <limits>
 #include <string>
 
 #include "core/progress.h"
@@ -41,6 +42,16 @@ struct TraceSettings {
   // included) and receives everyone's photons in batch order, so each rank
   // holds the map one process would trace (dist/comm.h).
   dist::Comm* comm = &dist::local();
+  // Animations (render/animation.h) trace the timeline in segments: path
+  // times spread over [timeOpen, timeClose] (scene seconds, inside the
+  // scene's shutter; NaN: the whole shutter) and the store quantises time
+  // over [storeT0, storeT1] (NaN: the path times' range), so that segments
+  // share one grid of time bins. Energies use ts = timeClose - timeOpen.
+  float timeOpen = std::numeric_limits<float>::quiet_NaN(), timeClose = std::numeric_limits<float>::quiet_NaN();
+  float storeT0 = std::numeric_limits<float>::quiet_NaN(), storeT1 = std::numeric_limits<float>::quiet_NaN();
+  // > 0: photons stored per emitted path, measured before (a pilot over the
+  // whole timeline): the pilot run is skipped and the emission sized by it.
+  double storedPerPath = 0;
 };
 
 struct TraceResult {
@@ -49,6 +60,7 @@ struct TraceResult {
   uint64_t rays = 0;     // rays cast, pilot included (throughput of the whole pass)
   double seconds = 0;
   std::string warning;   // set when the map is empty or smaller than wanted
+  double storedPerPath = 0;  // the pilot's rate (or the one given), 0 when nothing is stored
 };
 
 // Shutter interval the photon store quantises time over. A zero-length

@@ -17,11 +17,15 @@ struct PhotonMap {
   photon::KdTree tree;         // 3D, or 4D when built for the space-time search
   photon::PhotonStore store3;  // 4D maps only: a 3D-ordered copy
   photon::KdTree tree3;
+  // Animations (render/animation.h): store3/tree3 hold only the frame's own
+  // shutter, for the standard estimate, while `tree` spans the frame's time
+  // window (its shutter plus what the time kernel may reach).
+  bool separateStandard = false;
   uint64_t emitted = 0;
   double traceSeconds = 0, buildSeconds = 0;
   std::string warning;  // from tracing: empty map, or fewer photons than wanted
 
-  const photon::KdTree& spatialTree() const { return tree.spaceTime() ? tree3 : tree; }
+  const photon::KdTree& spatialTree() const { return tree.spaceTime() || separateStandard ? tree3 : tree; }
   size_t size() const { return store.size(); }
   double bytesPerPhoton() const;
 };

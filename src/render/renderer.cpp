@@ -97,6 +97,7 @@ struct SamplingPlan {
   // Distributed render: this rank samples only its own tiles, and the
   // half-buffer errors of every pixel are shared between passes.
   dist::Comm* comm = &dist::local();
+  float time01Lo = 0.0f, time01Hi = 1.0f;  // animation frames: sample times in this part of the shutter
 };
 
 template <class Integrator>
@@ -123,6 +124,7 @@ void samplePass(const Scene& scene, const Integrator& integrator, const Sampling
           CameraSample cs = ps.camera(i);
           if (plan.fixedTime01 >= 0) cs.time01 = plan.fixedTime01;
           else if (!plan.sampleTime) cs.time01 = 0.0f;
+          else cs.time01 = plan.time01Lo + cs.time01 * (plan.time01Hi - plan.time01Lo);  // whole shutter: unchanged
           Vec3f o, d;
           cam.generateRay({float(x) + cs.pixelOffset.x, float(y) + cs.pixelOffset.y}, cs.time01, o, d);
           typename PixelSampler::Stream stream = ps.stream(i);
@@ -446,6 +448,39 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
     comm.allreduceSum(counts, 2);
     st.standardEstimates = counts[0];
     st.timeEstimates = counts[1];
+  }
+  finishStats(film, st);
+  st.seconds = timer.seconds();
+  st.peakResidentBytes = peakResidentBytes();
+  return film;
+}
+
+Film renderFrame(const Scene& scene, const RenderOptions& opt, const FrameInput& frame, const Progress& progress,
+                 RenderStats& st) {
+  TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
+  Timer timer;
+  st = RenderStats{};
+  Film film(scene.camera.width(), scene.camera.height());
+  SamplingPlan plan;
+  plan.batch = opt.spp;
+  plan.maxSpp = std::max(opt.spp, opt.maxSpp);
+  plan.contrast = opt.contrast;
+  plan.seed = opt.seed;
+  plan.sampler = opt.sampler;
+  plan.time01Lo = scene.shutter.normalized(frame.shutter.open);
+  plan.time01Hi = scene.shutter.normalized(frame.shutter.close);
+  if (opt.method == "pathtrace") {
+    PathTracer pt(scene, opt.maxDepth);
+    renderPixels(scene, pt, plan, "render", progress, film);
+  } else {
+    PhotonIntegratorSettings s = integratorSettings(scene, opt, opt.method == "time" && scene.hasMotion);
+    if (!std::isfinite(opt.estimate.maxTimeDistance))
+      s.estimate.maxTimeDistance = opt.maxDtFraction * frame.shutter.length();
+    PhotonIntegrator integ(scene, frame.caustic, frame.global, s);
+    renderPixels(scene, integ, plan, "render", progress, film);
+    EstimateCounts c = integ.counts();
+    st.standardEstimates = c.standard;
+    st.timeEstimates = c.timeDependent;
   }
   finishStats(film, st);
   st.seconds = timer.seconds();

@@ -10,11 +10,14 @@
 #include "core/progress.h"
 #include "dist/comm.h"
 #include "estimate/estimators.h"
+#include "motion/shutter.h"
 #include "render/film.h"
 #include "sampling/sampler.h"
 #include "scene/scene.h"
 
 namespace tdpm {
+
+struct PhotonMap;
 
 // Adaptive sampling never stops a pixel before this many samples. A pixel
 // whose value is carried by paths of probability q per sample misses all
@@ -99,6 +102,20 @@ bool isRenderMethod(const std::string& name);
 // tiles only); bit-identical to one process (docs/distributed.md).
 Film render(const Scene& scene, const RenderOptions& options, const Progress& progress, RenderStats& stats,
             dist::Comm& comm = dist::local());
+
+// One frame of an animation (render/animation.h): camera samples take
+// times in `shutter` (scene seconds, inside the scene's shutter, which is
+// the whole timeline) and photon methods (time, standard) use the given
+// maps, whose standard trees hold only this frame's photons. No memory
+// check (the caller made it). Where a progressive frame will call the
+// progressive renderer with the same input.
+struct FrameInput {
+  Shutter shutter;
+  const PhotonMap* caustic = nullptr;
+  const PhotonMap* global = nullptr;
+};
+Film renderFrame(const Scene& scene, const RenderOptions& options, const FrameInput& frame, const Progress& progress,
+                 RenderStats& stats);
 
 // ---- photon memory budget ----
 // Peak bytes the photon passes hold for maps of `caustic` and `global`

@@ -134,8 +134,23 @@ struct RenderSettings {
   std::optional<int> gather;              // final-gather rays per sample, >= 0
 };
 
+// An animation (docs/scene-format.md, "animation"): frame i exposes
+// [i / fps, i / fps + (shutterAngle / 360) / fps] seconds; every keyframe
+// time lies in [0, frames / fps], which is then the camera's shutter (the
+// whole timeline, so the scene is built once for every frame).
+struct AnimationDesc {
+  double fps = 24;             // > 0
+  int frames = 1;              // >= 1
+  double shutterAngle = 180;   // degrees, (0, 360]
+  double duration() const { return double(frames) / fps; }
+  double frameOpen(int i) const { return double(i) / fps; }
+  double frameClose(int i) const { return frameOpen(i) + (shutterAngle / 360.0) / fps; }
+  double shutterLength() const { return (shutterAngle / 360.0) / fps; }
+};
+
 struct SceneDescription {
   std::string sourcePath;  // the JSON file, as given
+  std::optional<AnimationDesc> animation;  // absent: one frame, camera.shutter
   CameraDesc camera;
   std::vector<MaterialDesc> materials;
   std::vector<ObjectDesc> objects;

@@ -21,6 +21,7 @@
 #include "scene/json_locate.h"
 #include "scene/limits.h"
 #include "scene/mesh_obj.h"
+#include "scene/parse_animation.h"
 #include "scene/parse_node.h"
 
 namespace tdpm::scene {
@@ -40,6 +41,7 @@ constexpr float kDegrees = kPi / 180.0f;
 
 struct Shutter {
   float open = 0, close = 1;
+  const char* name = "the shutter";  // "the animation" when the interval is an animation's timeline
 };
 
 std::string fmt(double v) { return formatNumber(v); }
@@ -154,7 +156,7 @@ float readKeyTime(const Node& key, size_t index, float previous, Shutter s) {
   t.require(index == 0 || time > previous,
             "keyframe times must be strictly increasing: " + fmt(time) + " does not come after " + fmt(previous));
   t.require(time >= s.open && time <= s.close,
-            "time " + fmt(time) + " is outside the shutter [" + fmt(s.open) + ", " + fmt(s.close) + "]");
+            "time " + fmt(time) + " is outside " + s.name + " [" + fmt(s.open) + ", " + fmt(s.close) + "]");
   // motion/motion.cpp divides a keyframe pair's rotation by its share of the
   // shutter (to choose the step count, an int): shares below ~4e-8 overflow it.
   float gap = limits::kMinKeyframeGap * (s.close - s.open);
@@ -265,10 +267,10 @@ void readShutter(const Node& n, CameraDesc* cam) {
 }
 
 // Camera keyframes default to the camera's own position, target and up.
-std::vector<CameraKeyframe> readCameraMotion(const Node& n, const CameraDesc& cam) {
+std::vector<CameraKeyframe> readCameraMotion(const Node& n, const CameraDesc& cam, const char* interval) {
   std::vector<CameraKeyframe> keys;
   size_t count = keyframeCount(n);
-  Shutter s{cam.shutterOpen, cam.shutterClose};
+  Shutter s{cam.shutterOpen, cam.shutterClose, interval};
   for (size_t i = 0; i < count; ++i) {
     Node key = n.element(i);
     key.expectObject({"time", "position", "target", "up"});
@@ -283,9 +285,14 @@ std::vector<CameraKeyframe> readCameraMotion(const Node& n, const CameraDesc& ca
   return keys;
 }
 
-CameraDesc readCamera(const Node& n) {
+CameraDesc readCamera(const Node& n, const std::optional<AnimationDesc>& animation) {
   n.expectObject({"position", "target", "up", "fov", "resolution", "shutter", "motion"});
   CameraDesc cam;
+  if (animation) {
+    // The animation's timeline is the shutter every keyframe lives in.
+    cam.shutterOpen = 0.0f;
+    cam.shutterClose = float(animation->duration());
+  }
   if (n.has("position")) cam.position = n.member("position").vec3();
   if (n.has("target")) cam.target = n.member("target").vec3();
   if (n.has("up")) cam.up = n.member("up").vec3();
@@ -296,8 +303,13 @@ CameraDesc readCamera(const Node& n) {
     f.require(cam.fovDegrees > 0 && cam.fovDegrees < 180, "fov must be in (0, 180) degrees, got " + fmt(cam.fovDegrees));
   }
   if (n.has("resolution")) readResolution(n.member("resolution"), &cam);
-  if (n.has("shutter")) readShutter(n.member("shutter"), &cam);
-  if (n.has("motion")) cam.motion = readCameraMotion(n.member("motion"), cam);
+  if (n.has("shutter")) {
+    n.member("shutter").require(!animation, "camera.shutter cannot be used together with \"animation\": each frame's "
+                                            "shutter is [i / fps, i / fps + (shutter_angle / 360) / fps]; remove "
+                                            "camera.shutter or the animation block");
+    readShutter(n.member("shutter"), &cam);
+  }
+  if (n.has("motion")) cam.motion = readCameraMotion(n.member("motion"), cam, animation ? "the animation" : "the shutter");
   return cam;
 }
 
@@ -699,11 +711,13 @@ RenderSettings readRender(const Node& n, float shutterLength) {
 // ---------------------------------------------------------------- scene
 
 SceneDescription readScene(const Node& root, const std::string& sourcePath) {
-  root.expectObject({"camera", "materials", "objects", "lights", "background", "render"});
+  root.expectObject({"camera", "materials", "objects", "lights", "background", "render", "animation"});
   SceneDescription scene;
   scene.sourcePath = sourcePath;
-  scene.camera = readCamera(root.required("camera"));
-  Shutter shutter{scene.camera.shutterOpen, scene.camera.shutterClose};
+  if (root.has("animation")) scene.animation = readAnimation(root.member("animation"));
+  scene.camera = readCamera(root.required("camera"), scene.animation);
+  Shutter shutter{scene.camera.shutterOpen, scene.camera.shutterClose,
+                  scene.animation ? "the animation" : "the shutter"};
   if (root.has("materials")) scene.materials = readMaterials(root.member("materials"));
   std::string sceneDir = std::filesystem::path(sourcePath).parent_path().string();
   Node objects = root.required("objects");
@@ -716,7 +730,9 @@ SceneDescription readScene(const Node& root, const std::string& sourcePath) {
     for (size_t i = 0; i < n; ++i) scene.lights.push_back(readLight(lights.element(i), shutter));
   }
   if (root.has("background")) scene.background = root.member("background").color();
-  if (root.has("render")) scene.render = readRender(root.member("render"), shutter.close - shutter.open);
+  if (root.has("render"))
+    scene.render = readRender(root.member("render"), scene.animation ? float(scene.animation->shutterLength())
+                                                                       : shutter.close - shutter.open);
   return scene;
 }
 

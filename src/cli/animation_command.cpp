@@ -1,0 +1,280 @@
+// cli/animation_command.cpp — the frames of an animation to files, and the
+// video preview by ffmpeg (run as a child process, never through a shell).
+#include "cli/animation_command.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "cli/frame_pattern.h"
+#include "cli/progress_bar.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/memory.h"
+#include "core/timer.h"
+#include "image/png.h"
+#include "render/animation.h"
+#include "render/film_output.h"
+#include "render/threads.h"
+#include "scene/scene.h"
+
+namespace tdpm::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::string directoryOf(const std::string& path) {
+  size_t slash = path.find_last_of('/');
+  if (slash == std::string::npos) return ".";
+  return slash == 0 ? "/" : path.substr(0, slash);
+}
+
+std::string stemOf(const std::string& path) {
+  size_t slash = path.find_last_of('/');
+  std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  size_t dot = name.find_last_of('.');
+  return dot == std::string::npos || dot == 0 ? name : name.substr(0, dot);
+}
+
+// Creates `dir` and its parents; names the flag and the directory on failure.
+void makeDirectories(const std::string& dir, const std::string& flag) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw Error(flag + ": cannot create directory '" + dir + "' (" + ec.message() + ")");
+  if (access(dir.c_str(), W_OK) != 0)
+    throw Error(flag + ": cannot write to directory '" + dir + "' (" + std::strerror(errno) + ")");
+}
+
+// Runs ffmpeg (argv[0] is its full path) with stdout and stderr into `log`;
+// returns its exit status (-1: did not run or was killed).
+int runProcess(const std::vector<std::string>& argv, const std::string& log) {
+  std::vector<char*> args;
+  for (const std::string& s : argv) args.push_back(const_cast<char*>(s.c_str()));
+  args.push_back(nullptr);
+  pid_t pid = fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    int in = open("/dev/null", O_RDONLY);
+    if (fd >= 0) {
+      dup2(fd, 1);
+      dup2(fd, 2);
+    }
+    if (in >= 0) dup2(in, 0);
+    execv(args[0], args.data());
+    _exit(127);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string readTail(const std::string& path, size_t max) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string s = ss.str();
+  while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
+  return s.size() > max ? "..." + s.substr(s.size() - max) : s;
+}
+
+// The PNG previews, in order, as a video: numbered links in a temporary
+// directory beside the video, ffmpeg writes into it, and the result is
+// renamed into place (a failure leaves any old video as it was).
+void assembleVideo(const std::string& ffmpeg, const std::string& video, const std::vector<std::string>& previews,
+                   double fps) {
+  std::string tmpl = directoryOf(video) + "/.tdpm-video-XXXXXX";
+  std::vector<char> buf(tmpl.begin(), tmpl.end());
+  buf.push_back('\0');
+  if (!mkdtemp(buf.data())) throw Error("--video: cannot create a temporary directory beside '" + video + "' (" +
+                                        std::strerror(errno) + ")");
+  std::string tmp(buf.data());
+  struct Cleanup {
+    std::string dir;
+    ~Cleanup() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  } cleanup{tmp};
+  for (size_t i = 0; i < previews.size(); ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/%06zu.png", i);
+    std::error_code ec;
+    fs::create_symlink(fs::absolute(previews[i]), tmp + name, ec);
+    if (ec) throw Error("--video: cannot link '" + previews[i] + "' (" + ec.message() + ")");
+  }
+  bool gif = endsWith(video, ".gif");
+  std::string out = tmp + (gif ? "/video.gif" : "/video.mp4");
+  char rate[32];
+  std::snprintf(rate, sizeof rate, "%.9g", fps);
+  std::vector<std::string> argv{ffmpeg, "-nostdin", "-y", "-loglevel", "error", "-framerate", rate,
+                                "-i", tmp + "/%06d.png"};
+  if (!gif) {
+    // H.264 in yuv420p (what players accept) needs even sizes.
+    for (const char* a : {"-vf", "scale=trunc(iw/2)*2:trunc(ih/2)*2", "-pix_fmt", "yuv420p"}) argv.push_back(a);
+  }
+  argv.push_back(out);
+  std::string log = tmp + "/ffmpeg.log";
+  int code = runProcess(argv, log);
+  if (code != 0)
+    throw Error("--video: ffmpeg failed (exit status " + std::to_string(code) + ") making '" + video +
+                "': " + readTail(log, 600));
+  if (std::rename(out.c_str(), video.c_str()) != 0)
+    throw Error("--video: cannot rename the video into '" + video + "' (" + std::strerror(errno) + ")");
+}
+
+}  // namespace
+
+std::string findOnPath(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  if (!path) return "";
+  std::string p(path);
+  size_t start = 0;
+  while (start <= p.size()) {
+    size_t end = p.find(':', start);
+    if (end == std::string::npos) end = p.size();
+    std::string dir = p.substr(start, end - start);
+    if (dir.empty()) dir = ".";
+    std::string full = dir + "/" + name;
+    struct stat st;
+    if (stat(full.c_str(), &st) == 0 && S_ISREG(st.st_mode) && access(full.c_str(), X_OK) == 0) return full;
+    start = end + 1;
+  }
+  return "";
+}
+
+int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, const RenderOptions& opt,
+                 float exposure) {
+  Timer total;
+  const scene::AnimationDesc& anim = *descIn.animation;
+  // ---- everything that can be wrong, before any file is made ----
+  FrameRange range{0, anim.frames - 1};
+  if (a.frameRange) range = parseFrameRange(*a.frameRange, anim.frames);
+  std::string pattern = a.output.empty() ? stemOf(a.scene) + (range.count() > 1 ? "_####.exr" : ".exr") : a.output;
+  checkFramePattern(pattern, range);
+  if (!animationSupportsMethod(opt.method))
+    throw Error("--method: '" + opt.method + "' cannot render an animation (use time, standard or pathtrace)");
+  std::string ffmpeg;
+  if (a.video) {
+    if (!endsWith(*a.video, ".mp4") && !endsWith(*a.video, ".gif"))
+      throw Error("--video: '" + *a.video + "' must end in .mp4 or .gif");
+    ffmpeg = findOnPath("ffmpeg");
+    if (ffmpeg.empty())
+      throw Error("--video: ffmpeg was not found on PATH; install it (Debian: apt-get install ffmpeg) or leave out "
+                  "--video (the PNG previews are written either way)");
+  }
+  std::vector<std::string> outputs, previews;
+  for (int i = range.first; i <= range.last; ++i) {
+    outputs.push_back(formatFramePath(pattern, i));
+    previews.push_back(image::previewPathFor(outputs.back()));
+  }
+  // Only now is anything created: the output directories.
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    if (i == 0 || directoryOf(outputs[i]) != directoryOf(outputs[i - 1])) makeDirectories(directoryOf(outputs[i]), "--output");
+    try {
+      checkOutputPath(outputs[i]);
+      checkOutputPath(previews[i]);
+    } catch (const Error& e) {
+      throw Error(std::string("--output: ") + e.what());
+    }
+    for (const std::string* o : {&outputs[i], &previews[i]})
+      if (sameFile(*o, a.scene)) throw Error("--output: '" + *o + "' is the scene file '" + a.scene + "'");
+  }
+  if (a.video) {
+    makeDirectories(directoryOf(*a.video), "--video");
+    try {
+      checkOutputPath(*a.video);
+    } catch (const Error& e) {
+      throw Error(std::string("--video: ") + e.what());
+    }
+  }
+
+  ThreadLimit limit(a.threads);
+  ProgressBar bar(ProgressBar::shouldShow(a.quiet));
+  auto scene = Scene::build(descIn);
+  AnimationOptions ao;
+  ao.first = range.first;
+  ao.last = range.last;
+  ao.window = a.window.value_or(ao.window);
+  ao.independentFrames = a.independentFrames;
+  struct FrameLine {
+    int frame;
+    double seconds;
+    uint64_t samples;
+    int minSpp, maxSpp;
+  };
+  std::vector<FrameLine> lines;
+  uint64_t peakRss = 0;
+  Timer frameTimer;
+  AnimationStats stats = renderAnimation(*scene, anim, opt, ao, bar.progress(), [&](int i, Film&& film, const RenderStats& st) {
+    size_t k = size_t(i - range.first);
+    image::ExrFile exr = filmToExr(std::move(film));
+    char seconds[32], shutter[64];
+    std::snprintf(seconds, sizeof seconds, "%.3f", st.seconds);
+    std::snprintf(shutter, sizeof shutter, "%.9g %.9g", anim.frameOpen(i), anim.frameClose(i));
+    exr.metadata = {{"tdpm/version", TDPM_VERSION},
+                    {"tdpm/scene", a.scene},
+                    {"tdpm/method", opt.method},
+                    {"tdpm/frame", std::to_string(i)},
+                    {"tdpm/frame_shutter", shutter},
+                    {"tdpm/spp", std::to_string(opt.spp)},
+                    {"tdpm/max_spp", std::to_string(opt.maxSpp)},
+                    {"tdpm/spp_taken", std::to_string(st.minSpp) + "-" + std::to_string(st.maxSpp)},
+                    {"tdpm/seed", std::to_string(opt.seed)},
+                    {"tdpm/sampler", samplerName(opt.sampler)},
+                    {"tdpm/max_depth", std::to_string(opt.maxDepth)},
+                    {"tdpm/render_seconds", seconds}};
+    if (opt.method != "pathtrace") {
+      exr.metadata["tdpm/caustic_photons"] = std::to_string(st.causticStored);
+      exr.metadata["tdpm/global_photons"] = std::to_string(st.globalStored);
+    }
+    writeRenderOutputs(outputs[k], previews[k], exr, exposure);
+    lines.push_back({i, frameTimer.seconds(), st.cameraSamples, st.minSpp, st.maxSpp});
+    frameTimer.reset();
+    peakRss = std::max(peakRss, st.peakResidentBytes);
+  });
+  if (a.video) assembleVideo(ffmpeg, *a.video, previews, anim.fps);
+  bar.finish();
+  for (const std::string& w : stats.warnings) std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
+  peakRss = std::max(peakRss, peakResidentBytes());
+  if (!a.quiet) {
+    for (const FrameLine& l : lines)
+      std::fprintf(stderr, "tdpm: frame %d: %.2f s, %d-%d samples per pixel -> %s\n", l.frame, l.seconds, l.minSpp,
+                   l.maxSpp, outputs[size_t(l.frame - range.first)].c_str());
+    double all = total.seconds();
+    std::fprintf(stderr,
+                 "tdpm: %s, %s: %d frames (%d-%d) at %dx%d, %.2f s in all, %.2f s per frame; photons: %llu caustic, "
+                 "%llu global stored in %llu segments, %.2f s%s%s\n",
+                 a.scene.c_str(), opt.method.c_str(), range.count(), range.first, range.last, scene->camera.width(),
+                 scene->camera.height(), all, all / double(range.count()),
+                 static_cast<unsigned long long>(stats.causticStored),
+                 static_cast<unsigned long long>(stats.globalStored),
+                 static_cast<unsigned long long>(stats.segmentsTraced), stats.photonSeconds,
+                 a.video ? " -> video " : "", a.video ? a.video->c_str() : "");
+  }
+  if (a.stats) {
+    std::fprintf(stderr, "tdpm: stats:\n");
+    std::fprintf(stderr, "  peak resident memory: %llu bytes\n", static_cast<unsigned long long>(peakRss));
+    std::fprintf(stderr, "  peak photons held: %zu\n", stats.peakHeldPhotons);
+    std::fprintf(stderr, "  photon pass: %.3f s\n", stats.photonSeconds);
+  }
+  return 0;
+}
+
+}  // namespace tdpm::cli

@@ -1,0 +1,290 @@
+// render/animation.cpp — the photon timeline of an animation: its time
+// grid, its segments (traced once, held for a sliding window of frames),
+// the frame maps assembled from them, and the frame loop.
+#include "render/animation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include <tbb/task_arena.h>
+
+#include "core/error.h"
+#include "core/memory.h"
+#include "core/rng.h"
+#include "core/timer.h"
+#include "photon/tracer.h"
+#include "render/memory_budget.h"
+#include "render/photon_map.h"
+
+namespace tdpm {
+
+namespace {
+
+// A piece of the timeline between two consecutive cut points of the grid
+// (bins [lo, hi)): traced once, whichever frames use it.
+struct Segment {
+  int64_t lo = 0, hi = 0;
+  photon::PhotonStore caustic, global;
+  size_t size() const { return caustic.size() + global.size(); }
+};
+
+struct Kind {
+  photon::MapKind kind;
+  size_t perShutter;  // photons wanted per frame's shutter time
+};
+
+// The grid's cut points that matter for frames [first, last]: the ends of
+// every nearby frame's shutter and time map, clipped to the timeline.
+// Frames more than 5 periods away cannot cut inside these frames' maps (a
+// map spans S + 2P <= 3B + 2 bins), so the segments found here are the
+// same as for the whole timeline and do not depend on the frame range.
+std::vector<int64_t> cutPoints(const TimeGrid& g, int frames, int first, int last) {
+  const int64_t end = int64_t(frames) * g.binsPerFrame;
+  std::vector<int64_t> c{0, end};
+  for (int i = std::max(0, first - 5); i <= std::min(frames - 1, last + 5); ++i)
+    for (int64_t p : {g.mapLo(i), int64_t(i) * g.binsPerFrame, int64_t(i) * g.binsPerFrame + g.shutterBins, g.mapHi(i)})
+      c.push_back(std::clamp<int64_t>(p, 0, end));
+  std::sort(c.begin(), c.end());
+  c.erase(std::unique(c.begin(), c.end()), c.end());
+  return c;
+}
+
+bool inside(int64_t lo, int64_t hi, int64_t a, int64_t b) { return lo >= a && hi <= b; }
+
+// Frame i's map of one kind: every photon of the segments inside its time
+// map, re-binned on the frame's 256 bins (an integer shift: same grid), and
+// a 3D tree of its shutter's photons alone for the standard estimate.
+std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments, bool caustic, const TimeGrid& g,
+                                    int frame, bool spaceTime, float kappa) {
+  const int64_t lo = g.mapLo(frame), hi = g.mapHi(frame);
+  const int64_t s0 = int64_t(frame) * g.binsPerFrame, s1 = s0 + g.shutterBins;
+  auto map = std::make_unique<PhotonMap>();
+  photon::PhotonStore all(float(double(lo) * g.binWidth), float(double(lo + photon::kTimeBins) * g.binWidth));
+  photon::PhotonStore own(float(double(s0) * g.binWidth), float(double(s1) * g.binWidth));
+  size_t nAll = 0, nOwn = 0;
+  for (const Segment* s : segments) {
+    if (!inside(s->lo, s->hi, lo, hi)) continue;
+    size_t n = (caustic ? s->caustic : s->global).size();
+    nAll += n;
+    if (inside(s->lo, s->hi, s0, s1)) nOwn += n;
+  }
+  all.reserve(nAll);
+  own.reserve(nOwn);
+  for (const Segment* s : segments) {
+    if (!inside(s->lo, s->hi, lo, hi)) continue;
+    const photon::PhotonStore& st = caustic ? s->caustic : s->global;
+    const bool shutter = inside(s->lo, s->hi, s0, s1);
+    const int64_t last = s->hi - s->lo - 1;
+    for (size_t p = 0; p < st.size(); ++p) {
+      // A time a rounding error past the segment's end stays in it.
+      int64_t bin = s->lo + std::min<int64_t>(st.timeBin(p), last);
+      all.addEncoded(st.xs()[p], st.ys()[p], st.zs()[p], st.energies()[p], st.directions()[p], st.flags()[p],
+                     uint8_t(bin - lo));
+      if (shutter)
+        own.addEncoded(st.xs()[p], st.ys()[p], st.zs()[p], st.energies()[p], st.directions()[p], st.flags()[p],
+                       uint8_t((bin - s0) * photon::kTimeBins / g.shutterBins));
+    }
+  }
+  map->store = std::move(all);
+  photon::KdBuildOptions opt;
+  opt.spaceTime = spaceTime;
+  opt.kappa = kappa;
+  map->tree = photon::KdTree::build(map->store, opt);
+  map->store3 = std::move(own);
+  map->tree3 = photon::KdTree::build(map->store3, {});
+  map->separateStandard = true;
+  return map;
+}
+
+}  // namespace
+
+bool animationSupportsMethod(const std::string& m) { return m == "time" || m == "standard" || m == "pathtrace"; }
+
+Shutter frameShutter(const scene::AnimationDesc& a, int frame) {
+  return Shutter{float(a.frameOpen(frame)), float(a.frameClose(frame))};
+}
+
+TimeGrid makeTimeGrid(const scene::AnimationDesc& a, double reach) {
+  reach = std::clamp(reach, 0.0, 1.0);
+  const double share = a.shutterAngle / 360.0;  // of a frame period
+  auto fits = [&](int64_t B, TimeGrid& g) {
+    int64_t S = std::max<int64_t>(1, std::llround(double(B) * share));
+    int64_t P = int64_t(std::ceil(reach * double(S))) + 1;
+    if (S + 2 * P > photon::kTimeBins) return false;
+    g.binsPerFrame = B;
+    g.shutterBins = S;
+    g.padBins = P;
+    g.binWidth = 1.0 / (double(B) * a.fps);
+    return true;
+  };
+  TimeGrid best;
+  int64_t top = int64_t(std::floor(double(photon::kTimeBins) / share));
+  int64_t B = top;
+  while (B > 1 && !fits(B, best)) --B;
+  if (B <= 1) fits(1, best);
+  // Prefer a B (down to half the largest) whose shutter is whole bins:
+  // then the standard estimate's photons are exactly the shutter's.
+  for (int64_t b = B; b >= std::max<int64_t>(1, B / 2); --b) {
+    TimeGrid g;
+    if (fits(b, g) && std::fabs(double(b) * share - double(g.shutterBins)) < 1e-6) return g;
+  }
+  return best;
+}
+
+AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& anim, const RenderOptions& opt,
+                               const AnimationOptions& ao, const Progress& progress, const FrameSink& sink) {
+  if (!animationSupportsMethod(opt.method))
+    throw Error("method '" + opt.method + "' cannot render an animation (use time, standard or pathtrace)");
+  TDPM_ASSERT(ao.first >= 0 && ao.last < anim.frames && ao.first <= ao.last && ao.window >= 1, "bad frame range");
+  AnimationStats stats;
+  const double shutter = anim.shutterLength();
+  const double reach = std::isfinite(opt.estimate.maxTimeDistance) ? opt.estimate.maxTimeDistance / shutter
+                                                                     : double(opt.maxDtFraction);
+  const TimeGrid grid = makeTimeGrid(anim, reach);
+  const bool photons = opt.method != "pathtrace";
+  const bool wantGlobal = opt.visualizeGlobal || opt.gatherRays > 0;
+  const bool spaceTime = opt.spaceTime4D && opt.method == "time" && scene.hasMotion;
+  const size_t total = size_t(ao.last - ao.first + 1);
+
+  // Memory: the window's segments (each frame's shutter and pads) and one
+  // frame's two copies of its maps, at --photons per shutter.
+  if (photons) {
+    RenderOptions held = opt;
+    double factor = double(ao.window + 2) * double(grid.shutterBins + 2 * grid.padBins) / double(grid.shutterBins) + 1.0;
+    held.causticPhotons = size_t(double(opt.causticPhotons) * factor);
+    held.globalPhotons = wantGlobal ? size_t(double(opt.globalPhotons) * factor) : 0;
+    checkMemoryBudget(scene, held, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
+  } else {
+    checkMemoryBudget(scene, opt, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
+  }
+
+  std::string prefix;
+  Progress framed;
+  framed.report = [&](const std::string& stage, size_t done, size_t all) { progress(prefix + stage, done, all); };
+  framed.position = progress.position;
+
+  std::vector<Kind> kinds;
+  if (photons)
+    for (auto [kind, count] : {std::pair{photon::MapKind::Caustic, opt.causticPhotons},
+                               std::pair{photon::MapKind::Global, wantGlobal ? opt.globalPhotons : size_t(0)}})
+      kinds.push_back(Kind{kind, count});
+  // Pilot: stored photons per path, once per frame period and kind, over
+  // that frame's time map (the caustic map aims at where the specular
+  // objects are then). Segments of the period size their emission by it,
+  // so a frame's photons do not depend on the range or window of the run.
+  const int64_t timelineEnd = int64_t(anim.frames) * grid.binsPerFrame;
+  std::map<std::pair<int64_t, int>, double> rates;
+  auto rateFor = [&](int64_t period, const Kind& kd) {
+    auto key = std::pair{period, int(kd.kind)};
+    auto it = rates.find(key);
+    if (it != rates.end()) return it->second;
+    photon::TraceSettings ts;
+    ts.kind = kd.kind;
+    ts.storedWanted = 1;
+    ts.seed = hashCombine(opt.seed, 0x9170ull, uint64_t(period));
+    ts.maxBounces = opt.maxDepth;
+    ts.sampler = opt.sampler;
+    int frame = int(std::clamp<int64_t>(period, 0, anim.frames - 1));
+    ts.timeOpen = float(double(std::max<int64_t>(0, grid.mapLo(frame))) * grid.binWidth);
+    ts.timeClose = float(double(std::min(timelineEnd, grid.mapHi(frame))) * grid.binWidth);
+    photon::TraceResult r = photon::tracePhotons(scene, ts, Progress{});
+    if (!r.warning.empty() && std::find(stats.warnings.begin(), stats.warnings.end(), r.warning) == stats.warnings.end())
+      stats.warnings.push_back(r.warning);
+    return rates[key] = r.storedPerPath;
+  };
+
+  const std::vector<int64_t> cuts = cutPoints(grid, anim.frames, ao.first, ao.last);
+  std::map<int64_t, Segment> held;  // by lo
+  uint64_t emitted = 0;
+  progress.at(WorkPosition{"frame", 0, total, 0, 0});
+  for (int w0 = ao.first; w0 <= ao.last; w0 += ao.window) {
+    const int w1 = std::min(ao.last, w0 + ao.window - 1);
+    // Trace the segments this window's frames need that are not held yet.
+    Timer traceTimer;
+    if (photons)
+      for (size_t k = 0; k + 1 < cuts.size(); ++k) {
+        int64_t lo = cuts[k], hi = cuts[k + 1];
+        if (hi <= grid.mapLo(w0) || lo >= grid.mapHi(w1) || held.count(lo)) continue;
+        bool used = false;
+        for (int i = w0; i <= w1 && !used; ++i) used = inside(lo, hi, grid.mapLo(i), grid.mapHi(i));
+        if (!used) continue;
+        Segment seg;
+        seg.lo = lo;
+        seg.hi = hi;
+        // Seeded by the segment's place in its frame period, not by the
+        // frame: corresponding paths of every frame use the same random
+        // numbers, so still light on still geometry does not flicker
+        // (--independent-frames: by the segment's absolute place instead).
+        int64_t phase = lo % grid.binsPerFrame;
+        uint64_t key = ao.independentFrames ? uint64_t(lo) | (uint64_t(1) << 62) : uint64_t(phase);
+        const int64_t period = std::clamp<int64_t>((lo + grid.padBins) / grid.binsPerFrame, 0, anim.frames - 1);
+        for (const Kind& kd : kinds) {
+          if (kd.perShutter == 0) continue;
+          double rate = rateFor(period, kd);
+          if (!(rate > 0)) continue;
+          photon::TraceSettings ts;
+          ts.kind = kd.kind;
+          double share = double(hi - lo) / (double(grid.binsPerFrame) * anim.shutterAngle / 360.0);
+          ts.storedWanted = size_t(std::max(1.0, std::round(double(kd.perShutter) * share)));
+          ts.seed = hashCombine(opt.seed, key, uint64_t(hi - lo));
+          ts.maxBounces = opt.maxDepth;
+          ts.sampler = opt.sampler;
+          ts.timeOpen = float(double(lo) * grid.binWidth);
+          ts.timeClose = float(double(hi) * grid.binWidth);
+          ts.storeT0 = ts.timeOpen;
+          ts.storeT1 = float(double(lo + photon::kTimeBins) * grid.binWidth);
+          ts.storedPerPath = rate;
+          photon::TraceResult r = photon::tracePhotons(scene, ts, framed);
+          if (!r.warning.empty() && std::find(stats.warnings.begin(), stats.warnings.end(), r.warning) == stats.warnings.end())
+            stats.warnings.push_back(r.warning);
+          emitted += r.emitted;
+          bool c = kd.kind == photon::MapKind::Caustic;
+          (c ? stats.causticStored : stats.globalStored) += r.store.size();
+          (c ? stats.causticEmitted : stats.globalEmitted) += r.emitted;
+          (c ? seg.caustic : seg.global) = std::move(r.store);
+        }
+        ++stats.segmentsTraced;
+        held.emplace(lo, std::move(seg));
+      }
+    stats.photonSeconds += traceTimer.seconds();
+
+    for (int i = w0; i <= w1; ++i) {
+      prefix = "frame " + std::to_string(i) + " (" + std::to_string(i - ao.first + 1) + "/" + std::to_string(total) + "): ";
+      FrameInput in;
+      in.shutter = frameShutter(anim, i);
+      std::unique_ptr<PhotonMap> caustic, global;
+      size_t heldNow = 0;
+      for (const auto& [lo, s] : held) heldNow += s.size();
+      if (photons) {
+        Timer mapTimer;
+        std::vector<const Segment*> segs;
+        for (const auto& [lo, s] : held) segs.push_back(&s);
+        caustic = frameMap(segs, true, grid, i, spaceTime, opt.kappa);
+        global = frameMap(segs, false, grid, i, spaceTime, opt.kappa);
+        in.caustic = caustic.get();
+        in.global = global.get();
+        heldNow += caustic->store.size() + caustic->store3.size() + global->store.size() + global->store3.size();
+        stats.photonSeconds += mapTimer.seconds();
+      }
+      stats.peakHeldPhotons = std::max(stats.peakHeldPhotons, heldNow);
+      RenderStats st;
+      Film film = renderFrame(scene, opt, in, framed, st);
+      if (photons) {
+        st.causticStored = caustic->store3.size();  // the frame's own shutter
+        st.globalStored = global->store3.size();
+      }
+      caustic.reset();
+      global.reset();
+      sink(i, std::move(film), st);
+      progress.at(WorkPosition{"frame", size_t(i - ao.first + 1), total, 0, emitted});
+    }
+    // Free what no later frame of this run needs.
+    for (auto it = held.begin(); it != held.end();)
+      it = it->second.hi <= grid.mapLo(w1 + 1) ? held.erase(it) : std::next(it);
+  }
+  return stats;
+}
+
+}  // namespace tdpm

@@ -1,0 +1,76 @@
+// render/animation.h — frame sequences from one photon timeline
+// (docs/animation.md). The scene is built once over the whole timeline
+// [0, frames / fps]; photons are traced once over the parts of it that some
+// frame can use (its shutter, and the closed-shutter time its time kernel
+// may reach), in segments on one grid of time bins, and each frame renders
+// with renderFrame() (render/renderer.h) from a map assembled from the
+// segments around it. Only a sliding window of frames' segments is held.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/progress.h"
+#include "motion/shutter.h"
+#include "render/film.h"
+#include "render/renderer.h"
+#include "scene/description.h"
+#include "scene/scene.h"
+
+namespace tdpm {
+
+// The time grid every segment and frame map shares: bins of `binWidth`
+// seconds, `binsPerFrame` to a frame period (so every shutter opens on a
+// bin edge). Frame i's shutter is bins [i B, i B + S), its time map spans
+// [i B - P, i B + S + P), with S + 2P <= 256 (one 8-bit photon time range).
+struct TimeGrid {
+  int64_t binsPerFrame = 256;  // B
+  int64_t shutterBins = 128;   // S (the shutter, rounded to whole bins when B * angle / 360 is not whole)
+  int64_t padBins = 0;         // P: how far the time kernel reaches beyond the shutter, plus one bin
+  double binWidth = 1.0;       // seconds: 1 / (B fps)
+  int64_t mapLo(int frame) const { return int64_t(frame) * binsPerFrame - padBins; }
+  int64_t mapHi(int frame) const { return int64_t(frame) * binsPerFrame + shutterBins + padBins; }
+};
+
+// reach: the time kernel's largest distance, as a fraction of the shutter
+// (capped at 1). Chooses the largest B that fits, preferring one that makes
+// S whole.
+TimeGrid makeTimeGrid(const scene::AnimationDesc& animation, double reach);
+
+// Frame i's shutter in scene seconds: [i / fps, i / fps + (angle / 360) / fps].
+Shutter frameShutter(const scene::AnimationDesc& animation, int frame);
+
+struct AnimationOptions {
+  int first = 0, last = 0;  // frames to render, inclusive
+  int window = 4;           // frames whose photon segments are traced and held together
+  // Photon segments seeded by their place on the timeline, so that frames'
+  // photons are independent; default: by their place in the frame period,
+  // so corresponding paths of every frame share random numbers and still
+  // lighting does not flicker (docs/animation.md).
+  bool independentFrames = false;
+};
+
+struct AnimationStats {
+  double photonSeconds = 0;                   // tracing, and building frame maps
+  uint64_t causticStored = 0, globalStored = 0, causticEmitted = 0, globalEmitted = 0;
+  uint64_t segmentsTraced = 0;
+  size_t peakHeldPhotons = 0;                 // segments + the frame's maps, at most
+  std::vector<std::string> warnings;
+};
+
+// Called after each frame with its film and statistics (photon figures of
+// the frame: its maps' sizes), in frame order; the caller writes the files.
+using FrameSink = std::function<void(int frame, Film&& film, const RenderStats& stats)>;
+
+// Renders options.first..options.last. Methods: time, standard, pathtrace
+// (others are refused with an Error). `--photons` counts are per frame's
+// shutter time. Reports progress.at(WorkPosition{"frame", ...}).
+AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& animation, const RenderOptions& options,
+                               const AnimationOptions& animationOptions, const Progress& progress,
+                               const FrameSink& sink);
+
+// The methods renderAnimation accepts, for messages.
+bool animationSupportsMethod(const std::string& method);
+
+}  // namespace tdpm
