@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "cli/frame_pattern.h"
+#include "dist/comm.h"
 #include "cli/progress_bar.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -164,13 +165,18 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
   Timer total;
   const scene::AnimationDesc& anim = *descIn.animation;
   // ---- everything that can be wrong, before any file is made ----
+  // Under mpirun every rank checks; an error is reported once by rank 0 and
+  // every rank exits 1 (dist::raiseIfAnyFailed).
+  dist::Comm& comm = dist::world();
   FrameRange range{0, anim.frames - 1};
+  std::string pattern, ffmpeg, setupError;
+  std::vector<std::string> outputs, previews;
+  try {
   if (a.frameRange) range = parseFrameRange(*a.frameRange, anim.frames);
-  std::string pattern = a.output.empty() ? stemOf(a.scene) + (range.count() > 1 ? "_####.exr" : ".exr") : a.output;
+  pattern = a.output.empty() ? stemOf(a.scene) + (range.count() > 1 ? "_####.exr" : ".exr") : a.output;
   checkFramePattern(pattern, range);
   if (!animationSupportsMethod(opt.method))
     throw Error("--method: '" + opt.method + "' cannot render an animation (use time, standard or pathtrace)");
-  std::string ffmpeg;
   if (a.video) {
     if (!endsWith(*a.video, ".mp4") && !endsWith(*a.video, ".gif"))
       throw Error("--video: '" + *a.video + "' must end in .mp4 or .gif");
@@ -179,7 +185,6 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
       throw Error("--video: ffmpeg was not found on PATH; install it (Debian: apt-get install ffmpeg) or leave out "
                   "--video (the PNG previews are written either way)");
   }
-  std::vector<std::string> outputs, previews;
   for (int i = range.first; i <= range.last; ++i) {
     outputs.push_back(formatFramePath(pattern, i));
     previews.push_back(image::previewPathFor(outputs.back()));
@@ -204,13 +209,24 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
       throw Error(std::string("--video: ") + e.what());
     }
   }
+  } catch (const Error& e) {
+    if (!comm.distributed()) throw;
+    setupError = e.what();
+  }
+  dist::raiseIfAnyFailed(comm, setupError);
 
   ThreadLimit limit(a.threads);
-  ProgressBar bar(ProgressBar::shouldShow(a.quiet));
+  // Under mpirun the frames are split over the ranks in contiguous blocks
+  // (a frame's image depends only on its index, so any split writes what one
+  // process would), each rank writing its own frames; rank 0 prints and
+  // assembles the video once every rank has finished (docs/distributed.md).
+  uint64_t blockLo = 0, blockHi = 0;
+  dist::blockRange(uint64_t(range.count()), comm.rank(), comm.size(), blockLo, blockHi);
+  ProgressBar bar(comm.root() && ProgressBar::shouldShow(a.quiet));
   auto scene = Scene::build(descIn);
   AnimationOptions ao;
-  ao.first = range.first;
-  ao.last = range.last;
+  ao.first = range.first + int(blockLo);
+  ao.last = range.first + int(blockHi) - 1;
   ao.window = a.window.value_or(ao.window);
   ao.independentFrames = a.independentFrames;
   struct FrameLine {
@@ -222,7 +238,11 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
   std::vector<FrameLine> lines;
   uint64_t peakRss = 0;
   Timer frameTimer;
-  AnimationStats stats = renderAnimation(*scene, anim, opt, ao, bar.progress(), [&](int i, Film&& film, const RenderStats& st) {
+  AnimationStats stats;
+  std::string frameError;
+  try {
+  if (ao.first <= ao.last)
+  stats = renderAnimation(*scene, anim, opt, ao, bar.progress(), [&](int i, Film&& film, const RenderStats& st) {
     size_t k = size_t(i - range.first);
     image::ExrFile exr = filmToExr(std::move(film));
     char seconds[32], shutter[64];
@@ -249,6 +269,14 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
     frameTimer.reset();
     peakRss = std::max(peakRss, st.peakResidentBytes);
   });
+  } catch (const Error& e) {
+    if (!comm.distributed()) throw;
+    frameError = e.what();
+  }
+  // Every rank's frames are written before the video is made; a failure on
+  // any rank is reported once and every rank exits 1.
+  dist::raiseIfAnyFailed(comm, frameError);
+  if (!comm.root()) return 0;
   if (a.video) assembleVideo(ffmpeg, *a.video, previews, anim.fps);
   bar.finish();
   for (const std::string& w : stats.warnings) std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
