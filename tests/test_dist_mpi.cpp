@@ -159,4 +159,26 @@ TEST_CASE("mpi: a rank that fails or dies during the render ends the job, with a
   std::system(("rm -rf '" + dir + "'").c_str());
 }
 
+TEST_CASE("mpi: 2 ranks split an animation's frames, each frame bit-identical to one process; bad range once") {
+  std::string dir = test::makeTempDir();
+  std::string args = "render '" + std::string(TDPM_SOURCE_DIR) + "/scenes/glass-ball-rolling.json'"
+                     " --resolution 48x27 --spp 2 --photons 4000 --global-photons 1000 -q --seed 3 ";
+  CommandResult one = test::runTdpm(args + "--frame-range 0-2 -t 2 -o " + dir + "/one/f_#.exr");
+  REQUIRE_MESSAGE(one.exitCode == 0, one.output);
+  CommandResult two = runMpi(2, "", args + "--frame-range 0-2 -t 1 -o " + dir + "/two/f_#.exr");
+  REQUIRE_MESSAGE(two.exitCode == 0, two.output);
+  for (int f = 0; f <= 2; ++f) {
+    std::string name = "/f_" + std::to_string(f) + ".exr";
+    REQUIRE(test::fileExists(dir + "/two" + name));
+    CHECK_MESSAGE(sameBits(image::readExr(dir + "/one" + name), image::readExr(dir + "/two" + name)), "frame " << f);
+  }
+  CHECK_FALSE(sameBits(image::readExr(dir + "/one/f_0.exr"), image::readExr(dir + "/one/f_2.exr")));
+  // A range outside the animation: one message, every rank exits 1, nothing written.
+  CommandResult bad = runMpi(2, "", args + "--frame-range 0-999 -t 1 -o " + dir + "/bad/f_###.exr", true);
+  CHECK(occurrences(bad.output, "--frame-range") == 1);
+  CHECK(occurrences(bad.output, "rank-exit 1") == 2);
+  CHECK_FALSE(test::fileExists(dir + "/bad/f_000.exr"));
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
 #endif  // TDPM_MPIEXEC
