@@ -23,7 +23,8 @@ struct RenderArgs {
   std::optional<int64_t> photons, globalPhotons;
   std::optional<int> frames, k, gather;
   std::optional<std::string> search, kernelSpace, kernelTime;
-  std::optional<std::string> sampler;
+  std::optional<std::string> sampler, filter;
+  std::optional<float> filterRadius;
   std::optional<float> fraction, kappa, maxRadius, maxDt;
   bool globalDirect = false;
   int threads = 0;  // 0: all cores
