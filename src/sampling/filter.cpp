@@ -41,12 +41,20 @@ PixelFilter::PixelFilter(FilterKind kind, float radius) : kind_(kind), radius_(r
   }
   for (int i = 1; i <= kFilterBins; ++i) cdf_[size_t(i)] = float(acc[size_t(i)] / sum);
   cdf_[kFilterBins] = 1.0f;
+  guide_.resize(kFilterBins);
+  size_t i = 0;
+  for (int j = 0; j < kFilterBins; ++j) {
+    float u = float(j) / float(kFilterBins);
+    while (i + 1 < size_t(kFilterBins) && cdf_[i + 1] <= u) ++i;
+    guide_[size_t(j)] = uint16_t(i);
+  }
 }
 
 float PixelFilter::sample1D(float u) const {
   if (kind_ == FilterKind::Box) return (2.0f * u - 1.0f) * radius_;
   // The bin i with cdf[i] <= u < cdf[i+1], then linear inside it.
-  size_t i = size_t(std::upper_bound(cdf_.begin() + 1, cdf_.end() - 1, u) - cdf_.begin()) - 1;
+  size_t i = guide_[std::min(size_t(u * float(kFilterBins)), size_t(kFilterBins - 1))];
+  while (i + 1 < size_t(kFilterBins) && cdf_[i + 1] <= u) ++i;
   float lo = cdf_[i], hi = cdf_[i + 1];
   float t = hi > lo ? (u - lo) / (hi - lo) : 0.5f;
   float w = 2.0f * radius_ / float(kFilterBins);

@@ -23,6 +23,7 @@
 // The inverse CDF is monotone, so a stratified u (Sobol, Latin hypercube)
 // stays stratified in the filter's measure.
 #pragma once
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,9 @@ class PixelFilter {
   FilterKind kind_;
   float radius_;
   std::vector<float> cdf_;  // gaussian: kFilterBins + 1 values, 0 .. 1
+  // guide_[j]: the bin holding u = j / kFilterBins, so a lookup starts
+  // there and steps a bin or two instead of a binary search.
+  std::vector<uint16_t> guide_;
 };
 
 }  // namespace tdpm
