@@ -627,9 +627,21 @@ TEST_CASE("scene parse: render settings and background") {
             "seed must be a non-negative integer, got a string");
   checkEdit([](Json& j) { j["render"] = {{"exposure", "+1"}}; }, "render.exposure", "expected a number, got a string");
   checkEdit([](Json& j) { j["render"] = {{"threads", 4}}; }, "render.threads",
-            "unknown key \"threads\"; allowed keys: contrast, exposure, fraction, frames, gather, global_photons, k, "
-            "kappa, kernel_space, kernel_time, max_depth, max_dt, max_radius, max_spp, method, photons, sampler, search, seed, spp");
+            "unknown key \"threads\"; allowed keys: contrast, exposure, filter, filter_radius, fraction, frames, gather, "
+            "global_photons, k, kappa, kernel_space, kernel_time, max_depth, max_dt, max_radius, max_spp, method, photons, "
+            "sampler, search, seed, spp");
   checkEdit([](Json& j) { j["render"] = {{"sampler", "halton"}}; }, "render.sampler", "halton");
+  checkEdit([](Json& j) { j["render"] = {{"filter", "mitchell"}}; }, "render.filter",
+            "unknown filter \"mitchell\"; expected one of box, gaussian");
+  checkEdit([](Json& j) { j["render"] = {{"filter_radius", 0}}; }, "render.filter_radius",
+            "filter_radius must be in [0.01, 16], got 0");
+  {
+    Json j = baseScene();
+    j["render"] = {{"filter", "gaussian"}, {"filter_radius", 2}};
+    auto d = parseScene(j.dump(), kFile);
+    CHECK(d.render.filter == std::string("gaussian"));
+    CHECK(*d.render.filterRadius == 2.0f);
+  }
   checkEdit([](Json& j) { j["render"] = {{"fraction", 0}}; }, "render.fraction", "fraction must be in [1e-06, 1], got 0");
   checkEdit([](Json& j) { j["render"] = {{"fraction", 1.5}}; }, "render.fraction", "fraction must be in [1e-06, 1], got 1.5");
   checkEdit([](Json& j) { j["render"] = {{"photons", -1}}; }, "render.photons", "photons must be at least 0, got -1");

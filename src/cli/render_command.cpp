@@ -238,6 +238,8 @@ RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc,
   o.contrast = pick(a.contrast, sc.contrast, o.contrast);
   o.seed = a.seed ? uint64_t(*a.seed) : sc.seed.value_or(o.seed);
   parseSamplerKind(pick(a.sampler, sc.sampler, std::string(samplerName(o.sampler))), o.sampler);  // both checked already
+  parseFilterKind(pick(a.filter, sc.filter, std::string(filterName(o.filter))), o.filter);
+  o.filterRadius = pick(a.filterRadius, sc.filterRadius, o.filterRadius);
   o.maxDepth = pick(a.maxDepth, sc.maxDepth, o.maxDepth);
   o.causticPhotons = size_t(pick(a.photons, sc.photons, int64_t(o.causticPhotons)));
   o.globalPhotons = size_t(pick(a.globalPhotons, sc.globalPhotons, int64_t(o.globalPhotons)));
@@ -330,6 +332,12 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_option("--sampler", a.sampler,
                  "Sample generator: sobol (Owen-scrambled Sobol, every dimension) or random (PCG32) (default sobol)")
       ->check(CLI::IsMember({"random", "sobol"}));
+  c->add_option("--filter", a.filter,
+                "Pixel filter, applied by drawing each sample's position from it: box (the pixel, default) or gaussian "
+                "(pbrt-v4's: sigma 0.5 px, radius 1.5 px; blurs about one pixel; docs/sampling.md)")
+      ->check(CLI::IsMember({"box", "gaussian"}));
+  c->add_option("--filter-radius", a.filterRadius, "Pixel filter radius in pixels (default: box 0.5, gaussian 1.5)")
+      ->check(rangeOf(limits::kFilterRadius));
   c->add_option("--max-depth", a.maxDepth, "Maximum path length in vertices (default 16)")->check(rangeOf(limits::kMaxDepth));
   c->add_option("--resolution", a.resolution, "Image size WxH (overrides the scene), e.g. 640x480");
   c->add_option("--exposure", a.exposure, "PNG preview exposure in stops (the EXR is unaffected)")
@@ -517,6 +525,7 @@ int runRender(const RenderArgs& a) {
                   {"tdpm/spp_taken", std::to_string(stats.minSpp) + "-" + std::to_string(stats.maxSpp)},
                   {"tdpm/seed", std::to_string(opt.seed)},
                   {"tdpm/sampler", samplerName(opt.sampler)},
+                  {"tdpm/filter", filterName(opt.filter)},
                   {"tdpm/max_depth", std::to_string(opt.maxDepth)},
                   {"tdpm/render_seconds", seconds}};
   bool photonMethod = opt.method != "pathtrace";

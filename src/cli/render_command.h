@@ -26,7 +26,8 @@ struct RenderArgs {
   std::optional<int64_t> photons, globalPhotons;
   std::optional<int> frames, k, gather;
   std::optional<std::string> search, kernelSpace, kernelTime;
-  std::optional<std::string> sampler;
+  std::optional<std::string> sampler, filter;
+  std::optional<float> filterRadius;
   std::optional<float> fraction, kappa, maxRadius, maxDt;
   std::optional<float> kernelFootprint;
   bool globalDirect = false;

@@ -92,6 +92,7 @@ struct SamplingPlan {
   float contrast = 0.05f;
   uint64_t seed = 1;
   SamplerKind sampler = SamplerKind::Sobol;
+  PixelFilter filter;           // where in (and around) the pixel a sample lands
   bool sampleTime = true;       // false: a scene without motion draws no times
   float fixedTime01 = -1.0f;    // >= 0: every sample at this time (accumulation frames)
   // Distributed render: this rank samples only its own tiles, and the
@@ -126,7 +127,8 @@ void samplePass(const Scene& scene, const Integrator& integrator, const Sampling
           else if (!plan.sampleTime) cs.time01 = 0.0f;
           else cs.time01 = plan.time01Lo + cs.time01 * (plan.time01Hi - plan.time01Lo);  // whole shutter: unchanged
           Vec3f o, d;
-          cam.generateRay({float(x) + cs.pixelOffset.x, float(y) + cs.pixelOffset.y}, cs.time01, o, d);
+          Vec2f p = plan.filter.sample(cs.pixelOffset);  // filter importance sampling: weight 1
+          cam.generateRay({float(x) + p.x, float(y) + p.y}, cs.time01, o, d);
           typename PixelSampler::Stream stream = ps.stream(i);
           Rgb L = integrator.radiance(o, d, cs.time01, stream, s.state);
           // A NaN sample is a bug upstream; never let it reach the film. An
@@ -386,6 +388,7 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
   plan.contrast = opt.contrast;
   plan.seed = opt.seed;
   plan.sampler = opt.sampler;
+  plan.filter = PixelFilter(opt.filter, opt.filterRadius > 0 ? opt.filterRadius : defaultFilterRadius(opt.filter));
   // A scene with no motion at all draws no time samples.
   plan.sampleTime = scene.hasMotion;
   plan.comm = &comm;

@@ -12,6 +12,7 @@
 #include "estimate/estimators.h"
 #include "motion/shutter.h"
 #include "render/film.h"
+#include "sampling/filter.h"
 #include "sampling/sampler.h"
 #include "scene/scene.h"
 
@@ -45,6 +46,8 @@ struct RenderOptions {
   float contrast = 0.05f;
   uint64_t seed = 1;
   SamplerKind sampler = SamplerKind::Sobol;  // sampling/sampler.h
+  FilterKind filter = FilterKind::Box;       // sampling/filter.h
+  float filterRadius = 0.0f;                 // pixels; 0: the kind's default
   int maxDepth = 16;
 
   // ---- photon methods ----

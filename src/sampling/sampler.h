@@ -79,9 +79,15 @@ struct RandomStream {
 };
 
 // sobol: padded, Owen-scrambled Sobol (see the top of this file).
+// Cost: sampling/sobol.h's reversed-bit form; the index is reversed once
+// per stream (per sample), not once per group.
 struct SobolStream {
   uint64_t pixelSeed = 0;
   uint32_t index = 0;
+  uint32_t reversedIndex = 0;
+
+  SobolStream() = default;
+  SobolStream(uint64_t seed, uint32_t i) : pixelSeed(seed), index(i), reversedIndex(reverseBits32(i)) {}
 
   struct GroupSeeds {
     uint32_t shuffle, scramble[3];
@@ -91,23 +97,24 @@ struct SobolStream {
     uint64_t h2 = mix64(h1);
     return {uint32_t(h1), {uint32_t(h1 >> 32), uint32_t(h2), uint32_t(h2 >> 32)}};
   }
-  static uint32_t coord(uint32_t shuffled, int d, uint32_t scramble) {
-    return owenScramble(sobolBits(shuffled, d), scramble);
+  // The shuffled index, reversed: shuffleIndex(index, seed) == reverseBits32(shuffledReversed(seed)).
+  uint32_t shuffledReversed(uint32_t seed) const { return laineKarrasPermutation(reversedIndex, seed); }
+  static float coord(uint32_t r, int d, uint32_t scramble) {
+    return bitsToFloat01(scrambledSobolReversed(r, d, scramble));
   }
   float get1D(uint64_t group) const {
     GroupSeeds s = seeds(group);
-    return bitsToFloat01(coord(shuffleIndex(index, s.shuffle), 0, s.scramble[0]));
+    return coord(shuffledReversed(s.shuffle), 0, s.scramble[0]);
   }
   Vec2f get2D(uint64_t group) const {
     GroupSeeds s = seeds(group);
-    uint32_t i = shuffleIndex(index, s.shuffle);
-    return {bitsToFloat01(coord(i, 0, s.scramble[0])), bitsToFloat01(coord(i, 1, s.scramble[1]))};
+    uint32_t r = shuffledReversed(s.shuffle);
+    return {coord(r, 0, s.scramble[0]), coord(r, 1, s.scramble[1])};
   }
   Vec3f get3D(uint64_t group) const {
     GroupSeeds s = seeds(group);
-    uint32_t i = shuffleIndex(index, s.shuffle);
-    return {bitsToFloat01(coord(i, 0, s.scramble[0])), bitsToFloat01(coord(i, 1, s.scramble[1])),
-            bitsToFloat01(coord(i, 2, s.scramble[2]))};
+    uint32_t r = shuffledReversed(s.shuffle);
+    return {coord(r, 0, s.scramble[0]), coord(r, 1, s.scramble[1]), coord(r, 2, s.scramble[2])};
   }
 };
 

@@ -117,6 +117,8 @@ struct RenderSettings {
   std::optional<float> contrast;      // adaptive threshold, > 0
   std::optional<uint64_t> seed;
   std::optional<std::string> sampler; // random | sobol
+  std::optional<std::string> filter;  // box | gaussian
+  std::optional<float> filterRadius;  // pixels, (0, 16]
   std::optional<int> maxDepth;        // path vertices, >= 1
   std::optional<float> exposure;      // PNG preview: stops
   // photon methods

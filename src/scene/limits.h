@@ -65,6 +65,8 @@ constexpr FloatRange kFraction{1e-6f, 1.0f};
 constexpr FloatRange kExposure{-64.0f, 64.0f};
 // The estimators square it in float: r^2 must be a normal, finite float.
 constexpr FloatRange kMaxRadius{1.1e-19f, 1.8e19f};
+// Pixel filter radius in pixels (sampling/filter.h): a wider filter is a blur, not a filter.
+constexpr FloatRange kFilterRadius{0.01f, 16.0f};
 
 // ---- the 4D metric d^2 = |dx|^2 + kappa dt^2
 // The 4D kd-tree keys time as sqrt(kappa) t in float and resolves it to one

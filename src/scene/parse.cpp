@@ -674,13 +674,14 @@ const std::vector<std::string> kMethods = {"pathtrace", "static", "accumulation"
 
 const std::vector<std::string> kSearches = {"twopass", "4d"};
 const std::vector<std::string> kSamplers = {"random", "sobol"};
+const std::vector<std::string> kFilters = {"box", "gaussian"};
 const std::vector<std::string> kSpaceKernels = {"uniform", "cone", "epanechnikov"};
 const std::vector<std::string> kTimeKernels = {"uniform", "epanechnikov"};
 
 RenderSettings readRender(const Node& n, float shutterLength) {
   n.expectObject({"method", "spp", "max_spp", "contrast", "seed", "max_depth", "exposure", "photons", "global_photons",
                   "frames", "search", "k", "fraction", "kappa", "max_radius", "max_dt", "kernel_space", "kernel_time",
-                  "gather", "sampler"});
+                  "gather", "sampler", "filter", "filter_radius"});
   RenderSettings r;
   if (n.has("method")) r.method = n.member("method").choice(kMethods, "render method");
   if (n.has("spp")) r.spp = readCount(n.member("spp"), "spp", limits::kSpp);
@@ -688,6 +689,8 @@ RenderSettings readRender(const Node& n, float shutterLength) {
   if (n.has("contrast")) r.contrast = readPositive(n.member("contrast"), "contrast");
   if (n.has("seed")) r.seed = readSeed(n.member("seed"));
   if (n.has("sampler")) r.sampler = n.member("sampler").choice(kSamplers, "sampler");
+  if (n.has("filter")) r.filter = n.member("filter").choice(kFilters, "filter");
+  if (n.has("filter_radius")) r.filterRadius = readFloatInRange(n.member("filter_radius"), "filter_radius", limits::kFilterRadius);
   if (n.has("max_depth")) r.maxDepth = readCount(n.member("max_depth"), "max_depth", limits::kMaxDepth);
   if (n.has("exposure")) r.exposure = readFloatInRange(n.member("exposure"), "exposure", limits::kExposure);
   if (n.has("photons")) r.photons = readInRange(n.member("photons"), "photons", limits::kPhotons);
