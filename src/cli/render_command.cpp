@@ -325,7 +325,7 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_option("--max-spp", a.maxSpp, "Adaptive sampling: at most this many samples per pixel (default: --spp, i.e. not adaptive)")
       ->check(rangeOf(limits::kSpp));
   c->add_option("--contrast", a.contrast,
-                "Adaptive sampling: add batches while the relative standard error of a pixel's mean exceeds this (default 0.05)")
+                "Adaptive sampling: add batches while the relative standard error of a pixel's mean (judged on its 8 neighbours) exceeds this x sqrt(n / 64) after n samples, so that every pixel stops at the same error gain per sample (default 0.05; docs/sampling.md)")
       ->check(CLI::PositiveNumber);
   c->add_option("--seed", a.seed, "Random seed >= 0: same seed, same image, whatever --threads is")
       ->check(CLI::NonNegativeNumber);

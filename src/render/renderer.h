@@ -39,7 +39,8 @@ struct RenderOptions {
   // Adaptive sampling: every pixel takes `spp` samples, then further
   // batches of `spp` while the relative error of its mean luminance (judged
   // from two interleaved half-buffers over its 3x3 neighbourhood, at least
-  // 64 samples, see renderer.cpp) exceeds `contrast`, up to maxSpp.
+  // 64 samples, see renderer.cpp) exceeds `contrast` x sqrt(n / 64) after
+  // n samples, up to maxSpp.
   // maxSpp <= spp: exactly spp samples everywhere.
   int spp = 16;
   int maxSpp = 0;
