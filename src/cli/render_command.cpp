@@ -5,14 +5,17 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <csignal>
 #include <cmath>
 #include <cstring>
 #include <cstdio>
 #include <sstream>
 
 #include "cli/progress_bar.h"
+#include "cli/progressive_options.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/signals.h"
 #include "core/memory.h"
 #include "core/timer.h"
 #include "image/exr.h"
@@ -20,6 +23,7 @@
 #include "import/pbrt_import.h"
 #include "photon/store.h"
 #include "render/film_output.h"
+#include "render/progressive.h"
 #include "render/renderer.h"
 #include "render/threads.h"
 #include "scene/limits.h"
@@ -315,6 +319,7 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
       ->check(rangeOf(limits::kGather))->group(photonGroup);
   c->add_flag("--global-direct", a.globalDirect, "Show the global photon map directly at the first diffuse hit (debugging, tests)")
       ->group(photonGroup);
+  addProgressiveOptions(c, a);
   return c;
 }
 
@@ -358,6 +363,7 @@ int runRender(const RenderArgs& a) {
     if (o.shape.type == scene::ShapeDesc::Type::Mesh)
       refuseOverwritingInput(output, preview, o.shape.meshFile, "the mesh file of object '" + o.name + "'");
   RenderOptions opt = mergeOptions(a, desc.render, a.scene);
+  mergeProgressiveOptions(a, desc.render, a.scene, opt);
   float exposure = pick(a.exposure, desc.render.exposure, 0.0f);
   if (a.resolution) {
     desc.camera.width = width;
@@ -373,7 +379,12 @@ int runRender(const RenderArgs& a) {
   for (const std::string& w : accumulationSppWarnings(opt, scene->hasMotion))
     std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
   RenderStats stats;
-  Film film = render(*scene, opt, bar.progress(), stats);
+  // Progressive: the first SIGINT/SIGTERM/SIGHUP ends the loop after the
+  // current pass and the passes done are written; a second one aborts.
+  ProgressiveState progressiveState;
+  if (opt.progressive) signals::setMode(signals::Mode::Stop);
+  Film film = opt.progressive ? renderProgressive(*scene, opt, progressiveState, bar.progress(), stats)
+                              : render(*scene, opt, bar.progress(), stats);
   bar.finish();
   for (const std::string& w : stats.warnings) std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
   warnAccumulationPhotons(opt, scene->hasMotion, stats);
@@ -397,7 +408,8 @@ int runRender(const RenderArgs& a) {
     exr.metadata["tdpm/caustic_photons"] = std::to_string(stats.causticStored);
     exr.metadata["tdpm/global_photons"] = std::to_string(stats.globalStored);
     if (opt.method == "time") exr.metadata["tdpm/search"] = opt.spaceTime4D ? "4d" : "twopass";
-    if (opt.method == "accumulation") exr.metadata["tdpm/frames"] = std::to_string(opt.frames);
+    if (opt.method == "accumulation" && !opt.progressive) exr.metadata["tdpm/frames"] = std::to_string(opt.frames);
+    if (opt.progressive) addProgressiveMetadata(progressiveState, exr.metadata);
   }
   writeRenderOutputs(output, preview, exr, exposure);  // both files or neither
   stats.peakResidentBytes = peakResidentBytes();      // --stats: the write path included
@@ -416,6 +428,11 @@ int runRender(const RenderArgs& a) {
                    stats.bytesPerPhoton, stats.photonSeconds, static_cast<unsigned long long>(stats.timeEstimates),
                    static_cast<unsigned long long>(stats.standardEstimates));
   }
+  if (opt.progressive && !a.quiet) std::fprintf(stderr, "tdpm: progressive: %s\n", progressiveSummary(progressiveState).c_str());
+  if (int sig = signals::stopRequested())
+    std::fprintf(stderr, "tdpm: stopped by %s after pass %d: wrote the %d passes done to %s\n",
+                 sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "a signal",
+                 progressiveState.passesDone, progressiveState.passesDone, output.c_str());
   if (a.stats) printStats(stats);
   return 0;
 }

@@ -36,7 +36,16 @@ struct TraceSettings {
   // (docs/sampling.md): random = one PCG32 per batch (the maps of old),
   // sobol = Owen-scrambled Sobol indexed by the global path index.
   SamplerKind sampler = SamplerKind::Random;
+  // Progressive passes (render/progressive.h): paths > 0 traces exactly
+  // that many paths (a multiple of kPathsPerBatch), no pilot, with global
+  // path indices [firstPath, firstPath + paths) (firstPath a multiple of
+  // kPathsPerBatch too): pass i continues the sequences of the passes before.
+  uint64_t firstPath = 0;
+  uint64_t paths = 0;
 };
+
+// Paths per batch: the unit of emission counts and of TraceSettings::firstPath.
+constexpr uint64_t kPathsPerBatch = 1024;
 
 struct TraceResult {
   PhotonStore store;

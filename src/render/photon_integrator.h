@@ -16,6 +16,7 @@
 
 #include "core/rng.h"
 #include "estimate/estimators.h"
+#include "estimate/fixed_kernel.h"
 #include "render/photon_map.h"
 #include "sampling/sampler.h"
 #include "scene/scene.h"
@@ -29,6 +30,12 @@ struct PhotonIntegratorSettings {
   int gatherRays = 1;             // final-gather rays per eye sample
   bool visualizeGlobal = false;   // gather point = global-map estimate alone (no direct, no gather)
   int maxDepth = 16;
+  // Progressive passes (render/progressive.h): every estimate uses the fixed
+  // kernels below (estimate/fixed_kernel.h) instead of the k-NN: the
+  // space-time kernel where the time-dependent estimate applies, the spatial
+  // one over the whole shutter elsewhere (the skip rule).
+  bool fixedKernels = false;
+  estimate::MapKernel causticKernel, globalKernel;
 };
 
 struct EstimateCounts {
@@ -39,6 +46,7 @@ class PhotonIntegrator {
  public:
   struct ThreadState {
     std::unique_ptr<estimate::Gatherer> caustic, caustic3, global, global3;
+    std::unique_ptr<estimate::FixedKernelGatherer> fixed;  // fixedKernels only
     EstimateCounts counts;
   };
 
@@ -59,7 +67,7 @@ class PhotonIntegrator {
  private:
   Rgb estimate(const PhotonMap* map, std::unique_ptr<estimate::Gatherer>& g, std::unique_ptr<estimate::Gatherer>& g3,
                const Hit& hit, const struct ShadingContext& ctx, Vec3f wo, float time01, bool timeDependent,
-               EstimateCounts& counts) const;
+               ThreadState& ts) const;
   template <class Stream>
   Rgb finalGather(const Hit& hit, const struct ShadingContext& ctx, float time01, bool touched, Stream& sampler,
                   int vertex, ThreadState& ts) const;

@@ -20,6 +20,7 @@
 #include "render/photon_integrator.h"
 #include "render/memory_budget.h"
 #include "render/photon_map.h"
+#include "render/progressive.h"
 #include "render/tile_loop.h"
 #include "sampling/sampler.h"
 
@@ -337,6 +338,10 @@ bool isRenderMethod(const std::string& name) {
 Film render(const Scene& scene, const RenderOptions& opt, const Progress& progress, RenderStats& st) {
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
   if (!isRenderMethod(opt.method)) throw Error("unknown method '" + opt.method + "'");
+  if (opt.progressive) {  // render/progressive.h, from pass 0
+    ProgressiveState state;
+    return renderProgressive(scene, opt, state, progress, st);
+  }
   // Before any work: an image or photon budget that cannot fit is an error,
   // not an OOM kill (render/memory_budget.h).
   checkMemoryBudget(scene, opt, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
