@@ -80,6 +80,17 @@ void addProgressiveMetadata(const ProgressiveState& s, std::map<std::string, std
   if (a != s.settings.end()) m["tdpm/alpha"] = a->second;
 }
 
+Progress withPassLines(Progress p) {
+  auto previous = p.position;
+  p.position = [previous](const WorkPosition& w) {
+    if (previous) previous(w);
+    if (w.done == 0) return;
+    std::fprintf(stderr, "tdpm: pass %zu%s done, %.4g photon paths emitted in all\n", w.done,
+                 w.total ? (" of " + std::to_string(w.total)).c_str() : "", double(w.photonsEmitted));
+  };
+  return p;
+}
+
 std::string progressiveSummary(const ProgressiveState& s) {
   char buf[256];
   std::snprintf(buf, sizeof buf,

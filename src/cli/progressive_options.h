@@ -9,6 +9,7 @@
 #include <string>
 
 #include "cli/render_command.h"
+#include "core/progress.h"
 #include "render/progressive_state.h"
 #include "render/renderer.h"
 #include "scene/description.h"
@@ -26,6 +27,11 @@ void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& s
 
 // "tdpm/passes", "tdpm/photons_emitted", "tdpm/kernel_radius", ... from the state.
 void addProgressiveMetadata(const ProgressiveState& state, std::map<std::string, std::string>& metadata);
+
+// When no progress bar is drawn (stderr not a terminal) and not --quiet:
+// one line per finished pass on stderr, "tdpm: pass N done ...", so logs
+// (and tests waiting to send a signal) see the passes go by.
+Progress withPassLines(Progress p);
 
 // One summary line: passes, photons, final kernel, seconds.
 std::string progressiveSummary(const ProgressiveState& state);

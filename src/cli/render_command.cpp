@@ -383,7 +383,9 @@ int runRender(const RenderArgs& a) {
   // current pass and the passes done are written; a second one aborts.
   ProgressiveState progressiveState;
   if (opt.progressive) signals::setMode(signals::Mode::Stop);
-  Film film = opt.progressive ? renderProgressive(*scene, opt, progressiveState, bar.progress(), stats)
+  bool passLines = opt.progressive && !a.quiet && !ProgressBar::shouldShow(a.quiet);
+  Film film = opt.progressive ? renderProgressive(*scene, opt, progressiveState,
+                                                  passLines ? withPassLines(bar.progress()) : bar.progress(), stats)
                               : render(*scene, opt, bar.progress(), stats);
   bar.finish();
   for (const std::string& w : stats.warnings) std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
