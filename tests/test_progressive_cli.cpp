@@ -129,6 +129,15 @@ TEST_CASE("progressive cli: flags that need --progressive, and methods without a
     CHECK(r.exitCode == 1);
     CHECK(contains(r.output, "--progressive works with the methods time, accumulation and standard"));
   }
+  for (const char* flag : {"--max-spp 8", "--frames 4", "--search 4d", "--kernel-space cone", "--kappa 2"}) {
+    auto r = runTdpm("render '" + scene + "' --progressive " + flag + out);
+    CAPTURE(r.output);
+    CHECK(r.exitCode == 1);
+    CHECK(contains(r.output, std::string(flag).substr(0, std::string(flag).find(' '))));
+    CHECK(contains(r.output, "has no effect with --progressive"));
+  }
+  auto help = runTdpm("render --help");
+  for (const char* flag : {"--progressive", "--passes", "--time-limit", "--alpha"}) CHECK(contains(help.output, flag));
   std::string keyed = writeScene(dir, "k.json", "16, 12", 2000, 1000, ", \"passes\": 2");
   auto k = runTdpm("render '" + keyed + "'" + out);
   CHECK(k.exitCode == 1);

@@ -55,6 +55,27 @@ void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& s
   if (!isProgressiveMethod(o.method))
     throw Error("--progressive works with the methods time, accumulation and standard, not '" + o.method +
                 "' (set by " + (a.method ? std::string("--method") : "render.method in " + sourcePath + " or the default") + ")");
+  // Settings a progressive render does not use: a flag is an error (the
+  // user asked for something that would not happen), a scene key a note
+  // (the scene may be meant for fixed-budget renders too).
+  auto unused = [&](bool flag, bool key, const char* flagName, const char* keyName, const char* why) {
+    if (flag) throw Error(std::string(flagName) + " has no effect with --progressive (" + why + ")");
+    if (key)
+      std::fprintf(stderr, "tdpm: note: render.%s in %s is not used by --progressive (%s)\n", keyName,
+                   sourcePath.c_str(), why);
+  };
+  unused(a.maxSpp && *a.maxSpp > o.spp, sc.maxSpp && *sc.maxSpp > o.spp, "--max-spp", "max_spp",
+         "every pass takes --spp samples per pixel; more passes take more");
+  unused(bool(a.frames), bool(sc.frames), "--frames", "frames",
+         "accumulation --progressive renders one stratified time per pass");
+  unused(a.search && *a.search == "4d", sc.search && *sc.search == "4d", "--search 4d", "search",
+         "the passes gather with fixed kernels, not a k-NN search");
+  unused(a.kernelSpace && *a.kernelSpace != "uniform", sc.kernelSpace && *sc.kernelSpace != "uniform",
+         "--kernel-space", "kernel_space", "the fixed kernels are uniform");
+  unused(a.kernelTime && *a.kernelTime != "uniform", sc.kernelTime && *sc.kernelTime != "uniform", "--kernel-time",
+         "kernel_time", "the fixed kernels are uniform");
+  unused(bool(a.kappa), bool(sc.kappa), "--kappa", "kappa", "it weighs the 4d search, which passes do not use");
+  o.maxSpp = o.spp;
   if (a.passes) o.passes = *a.passes;
   else if (sc.passes) o.passes = *sc.passes;
   if (a.timeLimit) o.timeLimitSeconds = *a.timeLimit;
