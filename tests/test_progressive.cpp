@@ -12,6 +12,7 @@
 #include <cstring>
 #include <vector>
 
+#include "photon/tracer.h"
 #include "render/progressive.h"
 #include "render/renderer.h"
 #include "scene_fixtures.h"
@@ -328,4 +329,35 @@ TEST_CASE("progressive: a point-light caustic on a moving floor converges to the
   // flattens towards it.
   CHECK(err[1] < 0.85 * err[0]);
   CHECK(err[2] < 0.6 * err[0]);
+}
+
+TEST_CASE("progressive: a pass's photon paths continue the path indices of the passes before it") {
+  auto s = Scene::build(movingPlane(8));
+  photon::TraceSettings t;
+  t.kind = photon::MapKind::Global;
+  t.storedWanted = 1;
+  t.sampler = SamplerKind::Sobol;
+  t.seed = 4;
+  const uint64_t P = 4 * photon::kPathsPerBatch;
+  auto trace = [&](uint64_t first, uint64_t paths) {
+    photon::TraceSettings u = t;
+    u.firstPath = first;
+    u.paths = paths;
+    return photon::tracePhotons(*s, u, Progress{});
+  };
+  photon::TraceResult whole = trace(0, 2 * P), a = trace(0, P), b = trace(P, P);
+  CHECK(whole.emitted == 2 * P);
+  CHECK(a.emitted == P);
+  REQUIRE(a.store.size() + b.store.size() == whole.store.size());
+  for (size_t i = 0; i < whole.store.size(); ++i) {
+    const photon::PhotonStore& part = i < a.store.size() ? a.store : b.store;
+    size_t j = i < a.store.size() ? i : i - a.store.size();
+    CHECK(lengthSquared(part.position(j) - whole.store.position(i)) == 0.0f);
+    CHECK(part.timeBin(j) == whole.store.timeBin(i));
+  }
+  // Past 2^32 paths the sequences take new scrambles: not the first paths again.
+  photon::TraceResult far = trace(uint64_t(1) << 32, P);
+  int same = 0;
+  for (size_t i = 0; i < std::min(far.store.size(), a.store.size()); ++i) same += lengthSquared(far.store.position(i) - a.store.position(i)) == 0.0f;
+  CHECK(same == 0);
 }

@@ -322,12 +322,20 @@ struct Tracer {
     Rng rng(hashCombine(settings.seed, uint64_t(settings.kind) + 1, b), 0x9e37);
     // sobol: the path index is the sample index, the map's seed and kind the "pixel".
     uint64_t sobolSeed = hashCombine(settings.seed, uint64_t(settings.kind) + 1, 0x9407ull);
+    // Sequences are indexed by 32 bits: past 2^32 paths (a long progressive
+    // render) each further 2^32 take new scrambles instead of repeating the
+    // first paths. Below 2^32 nothing changes.
+    uint32_t timeScrambleHere = timeScramble;
+    if (uint64_t high = (b * kPathsPerBatch) >> 32) {
+      sobolSeed = hashCombine(sobolSeed, high);
+      timeScrambleHere ^= uint32_t(mix64(high ^ 0x7173ull));
+    }
     uint64_t rays = 0;
     for (uint32_t i = 0; i < kPathsPerBatch; ++i) {
       uint64_t g = b * kPathsPerBatch + i;
       // The time stays the scrambled van der Corput of the path index for
       // both kinds: it is already a stratified 1D sequence over the shutter.
-      float time01 = settings.spreadInTime ? scrambledVanDerCorput(uint32_t(g), timeScramble) : settings.fixedTime01;
+      float time01 = settings.spreadInTime ? scrambledVanDerCorput(uint32_t(g), timeScrambleHere) : settings.fixedTime01;
       if (settings.sampler == SamplerKind::Sobol) {
         SobolStream s{sobolSeed, uint32_t(g)};
         rays += tracePath(time01, s, energyScale, out);
