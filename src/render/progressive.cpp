@@ -344,8 +344,12 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
   if (!isProgressiveMethod(opt.method))
     throw Error("--progressive works with the methods time, accumulation and standard, not '" + opt.method + "'");
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
-  // One pass's memory, as a fixed-budget render of the same photon counts.
-  checkMemoryBudget(scene, opt, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
+  // One pass's memory, as a fixed-budget render of the same photon counts
+  // (a fixed-budget accumulation would split them over its frames: a pass
+  // holds them all, as standard does).
+  RenderOptions budget = opt;
+  if (budget.method == "accumulation") budget.method = "standard";
+  checkMemoryBudget(scene, budget, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
   Timer timer;
   st = RenderStats{};
   const int w = scene.camera.width(), h = scene.camera.height();
