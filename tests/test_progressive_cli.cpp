@@ -105,6 +105,12 @@ TEST_CASE("progressive cli: --passes N renders N passes and records them in the 
   CHECK(std::atof(exr.metadata["tdpm/kernel_radius"].c_str()) > 0.0);
   CHECK(std::atof(exr.metadata["tdpm/kernel_half_window"].c_str()) > 0.0);
   CHECK(std::atof(exr.metadata["tdpm/photons_emitted"].c_str()) > 0.0);
+  // A time limit stops after the pass that reaches it: a microsecond is
+  // reached by the first pass, whatever the machine.
+  auto t = runTdpm("render '" + scene + "' --progressive --time-limit 0.000001 -t 2 -o '" + dir + "/t.exr'");
+  INFO(t.output);
+  REQUIRE(t.exitCode == 0);
+  CHECK(image::readExr(dir + "/t.exr").metadata["tdpm/passes"] == "1");
   // The scene keys do the same.
   std::string keyed = writeScene(dir, "k.json", "16, 12", 2000, 1000, ", \"progressive\": true, \"passes\": 2");
   auto k = runTdpm("render '" + keyed + "' -t 2 -q -o '" + dir + "/k.exr'");
