@@ -361,3 +361,33 @@ TEST_CASE("progressive: a pass's photon paths continue the path indices of the p
   for (size_t i = 0; i < std::min(far.store.size(), a.store.size()); ++i) same += lengthSquared(far.store.position(i) - a.store.position(i)) == 0.0f;
   CHECK(same == 0);
 }
+
+TEST_CASE("progressive: pass kernels follow alpha, and the half window stops at one time bin keeping the volume") {
+  auto s = Scene::build(movingPlane(8));  // shutter [0, 1]: one bin is 1/256 s
+  ProgressiveState st;
+  st.scalars["kernel.caustic.radius_1"] = 0.1;
+  st.scalars["kernel.caustic.half_window_1"] = 0.05;
+  st.scalars["kernel.caustic.spatial_radius_1"] = 0.2;
+  st.scalars["kernel.global.radius_1"] = 0.1;
+  st.scalars["kernel.global.half_window_1"] = 1.1 / 256.0;  // 1.1 bins
+  st.scalars["kernel.global.spatial_radius_1"] = 0.2;
+  RenderOptions o;
+  o.method = "time";
+  for (float alpha : {0.0f, 0.5f}) {
+    o.alpha = alpha;
+    double a3 = alpha > 0 ? alpha : 4.0 / 7.0;
+    PassKernels k = kernelsForPass(st, o, *s, 9);
+    CHECK(k.caustic.radius == doctest::Approx(0.1 * kernelScale(9, a3, 3)));
+    CHECK(k.caustic.halfWindow == doctest::Approx(0.05 * kernelScale(9, a3, 3)));
+    CHECK(k.caustic.spatialRadius == doctest::Approx(0.2 * kernelScale(9, 2.0 / 3.0, 2)));  // time's fallback: 2/3
+    // The global window would fall below a bin: floored there, r^2 h keeps the schedule.
+    double s3 = kernelScale(9, a3, 3);
+    CHECK(1.1 * s3 < 1.0);
+    CHECK(k.global.halfWindow == doctest::Approx(1.0 / 256.0));
+    CHECK(double(k.global.radius) * k.global.radius * k.global.halfWindow ==
+          doctest::Approx(0.01 * s3 * s3 * (1.1 / 256.0) * s3).epsilon(1e-4));
+  }
+  o.method = "standard";
+  o.alpha = 0.5f;
+  CHECK(kernelsForPass(st, o, *s, 9).caustic.spatialRadius == doctest::Approx(0.2 * kernelScale(9, 0.5, 2)));
+}
