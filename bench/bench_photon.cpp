@@ -17,6 +17,7 @@
 
 #include "core/rng.h"
 #include "estimate/estimators.h"
+#include "estimate/fixed_kernel.h"
 #include "photon/kdtree.h"
 #include "photon/store.h"
 #include "photon/temporal_select.h"
@@ -271,6 +272,66 @@ void BM_SelectNthElement(benchmark::State& state) {
   state.SetItemsProcessed(int64_t(state.iterations()));
 }
 BENCHMARK(BM_SelectNthElement);
+
+// ---- fixed-radius range query (progressive passes) against the k-NN ----
+// Each query's radius is its own k-NN radius (k = 100 or 200), so both
+// searches return the same photons: the ratio BM_Range / BM_KnnOurs at one
+// k is the cost of the search itself, photons per query equal.
+
+const std::vector<float>& knnRadii2(int k, bool morton) {
+  static std::vector<float> cache[2][2];
+  std::vector<float>& r = cache[k == 200][morton];
+  if (r.empty()) {
+    Fixture& f = fixture();
+    const auto& qs = morton ? f.mortonQueries : f.randomQueries;
+    photon::KnnQuery q(k);
+    for (const Vec3f& p : qs) {
+      f.tree.knn(p, k, std::numeric_limits<float>::infinity(), q);
+      r.push_back(q.radius2);
+    }
+  }
+  return r;
+}
+
+void BM_Range(benchmark::State& state) {
+  Fixture& f = fixture();
+  const auto& qs = queriesFor(state);
+  const auto& r2 = knnRadii2(int(state.range(0)), state.range(1) != 0);
+  photon::RangeQuery q;
+  size_t i = 0;
+  uint64_t found = 0;
+  for (auto _ : state) {
+    size_t j = i++ & (kQueries - 1);
+    int n = f.tree.range(qs[j], r2[j], q);
+    found += uint64_t(n);
+    benchmark::DoNotOptimize(n);
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()));
+  state.counters["photons_per_query"] = double(found) / double(state.iterations());
+}
+BENCHMARK(BM_Range)->ArgsProduct({{100, 200}, {0, 1}})->ArgNames({"k", "morton"});
+
+// Whole fixed-kernel estimates (estimate/fixed_kernel.h) at the k = 200
+// radius: spatial (method 0) and space-time with h = 0.05 of the shutter
+// (method 1), beside BM_Estimate's k-NN estimates.
+void BM_FixedEstimate(benchmark::State& state) {
+  Fixture& f = fixture();
+  const auto& qs = queriesFor(state);
+  const auto& r2 = knnRadii2(200, state.range(1) != 0);
+  estimate::FixedKernelGatherer g;
+  estimate::ConstantBrdf brdf{Rgb(0.3f)};
+  Vec3f n(0, 1, 0);
+  size_t i = 0;
+  for (auto _ : state) {
+    size_t j = i++ & (kQueries - 1);
+    float r = std::sqrt(r2[j]);
+    Rgb L = state.range(0) == 0 ? g.spatial(f.tree, qs[j], n, n, r, brdf)
+                                : g.spaceTime(f.tree, qs[j], n, n, f.queryTimes[j], r, 0.05f, brdf);
+    benchmark::DoNotOptimize(L);
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()));
+}
+BENCHMARK(BM_FixedEstimate)->ArgsProduct({{0, 1}, {0, 1}})->ArgNames({"method", "morton"});
 
 // ---- whole estimates: standard k = 200 vs time-dependent k_s = 200, f = 0.5 ----
 

@@ -105,6 +105,10 @@ TEST_CASE("fingerprint: every image-changing option changes it, and is named") {
       {"min_radius2", [](RenderOptions& o) { o.estimate.minRadius2 = 1e-10f; }},
       {"gather", [](RenderOptions& o) { o.gatherRays = 0; }},
       {"global_direct", [](RenderOptions& o) { o.visualizeGlobal = true; }},
+      {"filter", [](RenderOptions& o) { o.filter = FilterKind::Gaussian; }},
+      {"filter_radius", [](RenderOptions& o) { o.filterRadius = 2.0f; }},
+      {"kernel_footprint", [](RenderOptions& o) { o.kernelFootprint = 2.0f; }},
+      {"alpha", [](RenderOptions& o) { o.alpha = 0.5f; }},
       // The smallest change a float can have: still seen.
       {"contrast", [](RenderOptions& o) { o.contrast = std::nextafter(o.contrast, 1.0f); }},
   };

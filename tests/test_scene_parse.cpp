@@ -628,8 +628,8 @@ TEST_CASE("scene parse: render settings and background") {
   checkEdit([](Json& j) { j["render"] = {{"exposure", "+1"}}; }, "render.exposure", "expected a number, got a string");
   checkEdit([](Json& j) { j["render"] = {{"threads", 4}}; }, "render.threads",
             "unknown key \"threads\"; allowed keys: contrast, exposure, filter, filter_radius, fraction, frames, gather, "
-            "global_photons, k, kappa, kernel_space, kernel_time, max_depth, max_dt, max_radius, max_spp, method, photons, "
-            "sampler, search, seed, spp");
+            "global_photons, k, kappa, kernel_space, kernel_time, max_depth, max_dt, max_radius, max_spp, method, passes, "
+            "photons, progressive, sampler, search, seed, spp, time_limit");
   checkEdit([](Json& j) { j["render"] = {{"sampler", "halton"}}; }, "render.sampler", "halton");
   checkEdit([](Json& j) { j["render"] = {{"filter", "mitchell"}}; }, "render.filter",
             "unknown filter \"mitchell\"; expected one of box, gaussian");
@@ -642,6 +642,9 @@ TEST_CASE("scene parse: render settings and background") {
     CHECK(d.render.filter == std::string("gaussian"));
     CHECK(*d.render.filterRadius == 2.0f);
   }
+  checkEdit([](Json& j) { j["render"] = {{"progressive", 1}}; }, "render.progressive", "expected true or false");
+  checkEdit([](Json& j) { j["render"] = {{"passes", 0}}; }, "render.passes", "passes");
+  checkEdit([](Json& j) { j["render"] = {{"time_limit", -1}}; }, "render.time_limit", "time_limit");
   checkEdit([](Json& j) { j["render"] = {{"fraction", 0}}; }, "render.fraction", "fraction must be in [1e-06, 1], got 0");
   checkEdit([](Json& j) { j["render"] = {{"fraction", 1.5}}; }, "render.fraction", "fraction must be in [1e-06, 1], got 1.5");
   checkEdit([](Json& j) { j["render"] = {{"photons", -1}}; }, "render.photons", "photons must be at least 0, got -1");

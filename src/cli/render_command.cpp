@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <csignal>
 #include <cmath>
 #include <cstring>
 #include <cstdio>
@@ -17,8 +18,10 @@
 #include "cli/frame_pattern.h"
 #include "cli/progress_bar.h"
 #include "cli/resume.h"
+#include "cli/progressive_options.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/signals.h"
 #include "core/memory.h"
 #include "core/timer.h"
 #include "dist/comm.h"
@@ -27,6 +30,7 @@
 #include "import/pbrt_import.h"
 #include "photon/store.h"
 #include "render/film_output.h"
+#include "render/progressive.h"
 #include "render/renderer.h"
 #include "render/threads.h"
 #include "scene/limits.h"
@@ -400,6 +404,7 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_flag("--independent-frames", a.independentFrames, "Seed every frame's photons independently (default: "
               "corresponding photon paths of every frame share random numbers, so still lighting does not flicker)")
       ->group(animationGroup);
+  addProgressiveOptions(c, a);
   return c;
 }
 
@@ -418,14 +423,10 @@ int runRender(const RenderArgs& a) {
   float exposure = 0.0f;
   std::unique_ptr<Scene> scene;
   std::string setupError;
-  // The --progressive flag of issue 10 enables this (and --resume): at merge,
-  // `= a.progressive`.
-  const bool progressive = false;
   const bool framePattern = hasFramePlaceholder(a.output);
   try {
   if (a.method && !isRenderMethod(*a.method))
     throw Error("--method: unknown method '" + *a.method + "' (expected " + methodList() + ")");
-  checkResumeFlags(a.resume ? &*a.resume : nullptr, progressive);
   int width = 0, height = 0;
   if (a.resolution) parseResolution(*a.resolution, width, height);
   // A pbrt scene names its own output (Film "filename"), known only once it is read.
@@ -464,6 +465,8 @@ int runRender(const RenderArgs& a) {
       if (o.shape.type == scene::ShapeDesc::Type::Mesh)
         refuseOverwritingInput(output, preview, o.shape.meshFile, "the mesh file of object '" + o.name + "'");
   opt = mergeOptions(a, desc.render, a.scene);
+  mergeProgressiveOptions(a, desc.render, a.scene, opt);
+  checkResumeFlags(a.resume ? &*a.resume : nullptr, opt.progressive);
   exposure = pick(a.exposure, desc.render.exposure, 0.0f);
   if (a.resolution) {
     desc.camera.width = width;
@@ -484,7 +487,15 @@ int runRender(const RenderArgs& a) {
   // one with this render's fingerprint (cli/resume.h); the pass loop
   // updates it and the output EXR carries it (docs/resume.md).
   ProgressiveState progressiveState;
-  if (progressive) progressiveState = initialProgressiveState(a.resume ? &*a.resume : nullptr, desc, opt);
+  if (opt.progressive) {
+    // Not yet split over ranks (docs/distributed.md), nor run per frame.
+    if (comm.distributed())
+      throw dist::AgreedError("--progressive: progressive rendering under mpirun is not supported yet; run it as one process");
+    if (desc.animation)
+      throw Error("--progressive: an animation's frames are rendered with a fixed photon budget; progressive frames are "
+                  "not supported yet (leave out --progressive, or render.progressive in " + a.scene + ")");
+    progressiveState = initialProgressiveState(a.resume ? &*a.resume : nullptr, desc, opt);
+  }
 
   if (desc.animation) return runAnimation(a, desc, opt, exposure);
   if (framePattern || a.frameRange || a.video || a.window || a.independentFrames)
@@ -505,7 +516,13 @@ int runRender(const RenderArgs& a) {
     for (const std::string& w : accumulationSppWarnings(opt, scene->hasMotion))
       std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
   RenderStats stats;
-  Film film = render(*scene, opt, bar.progress(), stats, comm);
+  // Progressive: the first SIGINT/SIGTERM/SIGHUP ends the loop after the
+  // current pass and the passes done are written; a second one aborts.
+  if (opt.progressive) signals::setMode(signals::Mode::Stop);
+  bool passLines = opt.progressive && !a.quiet && !ProgressBar::shouldShow(a.quiet);
+  Film film = opt.progressive ? renderProgressive(*scene, opt, progressiveState,
+                                                  passLines ? withPassLines(bar.progress()) : bar.progress(), stats)
+                              : render(*scene, opt, bar.progress(), stats, comm);
   bar.finish();
   // --stats: every rank's communication, gathered before rank 0 writes.
   std::vector<RankSeconds> ranks = gatherRankStats(comm, stats.seconds);
@@ -533,8 +550,13 @@ int runRender(const RenderArgs& a) {
     exr.metadata["tdpm/caustic_photons"] = std::to_string(stats.causticStored);
     exr.metadata["tdpm/global_photons"] = std::to_string(stats.globalStored);
     if (opt.method == "time") exr.metadata["tdpm/search"] = opt.spaceTime4D ? "4d" : "twopass";
-    if (opt.method == "accumulation") exr.metadata["tdpm/frames"] = std::to_string(opt.frames);
+    if (opt.method == "accumulation" && !opt.progressive) exr.metadata["tdpm/frames"] = std::to_string(opt.frames);
+    if (opt.progressive) addProgressiveMetadata(progressiveState, exr.metadata);
   }
+  // The state a later --resume continues from rides in the EXR (docs/resume.md).
+  const int passesDone = progressiveState.passesDone;
+  const std::string progressiveSummaryText = opt.progressive ? progressiveSummary(progressiveState) : std::string();
+  if (opt.progressive) addProgressiveState(std::move(progressiveState), exr);
   writeRenderOutputs(output, preview, exr, exposure);  // both files or neither
   stats.peakResidentBytes = peakResidentBytes();      // --stats: the write path included
 
@@ -553,6 +575,12 @@ int runRender(const RenderArgs& a) {
                    stats.bytesPerPhoton, stats.photonSeconds, static_cast<unsigned long long>(stats.timeEstimates),
                    static_cast<unsigned long long>(stats.standardEstimates));
   }
+  if (!progressiveSummaryText.empty() && !a.quiet)
+    std::fprintf(stderr, "tdpm: progressive: %s\n", progressiveSummaryText.c_str());
+  if (int sig = signals::stopRequested())
+    std::fprintf(stderr, "tdpm: stopped by %s after pass %d: wrote the %d passes done to %s\n",
+                 sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "a signal",
+                 passesDone, passesDone, output.c_str());
   if (a.stats) {
     printStats(stats);
     printRankStats(ranks);

@@ -37,6 +37,11 @@ struct RenderArgs {
   std::optional<std::string> frameRange, video;
   std::optional<int> window;
   bool independentFrames = false;
+  // progressive passes (cli/progressive_options.h)
+  bool progressive = false;
+  std::optional<int> passes;
+  std::optional<double> timeLimit;
+  std::optional<float> alpha;
   int threads = 0;  // 0: all cores
   bool quiet = false;
   bool stats = false;  // --stats: memory, photon and timing figures after the summary

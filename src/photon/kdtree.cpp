@@ -326,6 +326,61 @@ int KdTree::knnImpl(const float* key, int k, float maxRadius2, KnnQuery& q) cons
   return count;
 }
 
+void RangeQuery::grow() {
+  size_t n = std::max<size_t>(256, index_.size() * 2);
+  index_.resize(n);
+  dist2_.resize(n);
+}
+
+int KdTree::range(Vec3f p, float radius2, RangeQuery& q) const {
+  TDPM_ASSERT(!spaceTime_, "range() needs the 3D tree");
+  q.count = 0;
+  if (n_ == 0 || !(radius2 > 0.0f)) return 0;
+  if (q.index_.empty()) q.grow();
+  const float *X = store_->xs(), *Y = store_->ys(), *Z = store_->zs();
+  const uint16_t* F = store_->flags();
+  const uint32_t n = uint32_t(n_);
+  const float key[3] = {p.x, p.y, p.z};
+  uint32_t stack[128];  // far children waiting: at most one per level
+  int sp = 0, count = 0;
+  uint32_t cap = uint32_t(q.index_.size());
+  uint32_t* idx = q.index_.data();
+  float* d2 = q.dist2_.data();
+  uint32_t node = 0;
+  for (;;) {
+    for (;;) {
+      float dx = X[node] - key[0], dy = Y[node] - key[1], dz = Z[node] - key[2];
+      float dist = dx * dx + dy * dy + dz * dz;
+      if (dist <= radius2) {
+        if (uint32_t(count) == cap) {
+          q.grow();
+          cap = uint32_t(q.index_.size());
+          idx = q.index_.data();
+          d2 = q.dist2_.data();
+        }
+        idx[count] = node;
+        d2[count] = dist;
+        ++count;
+      }
+      uint32_t left = 2 * node + 1;
+      if (left >= n) break;
+      int axis = (F[node] & kAxisMask) >> kAxisShift;
+      float delta = key[axis] - (axis == 0 ? X[node] : axis == 1 ? Y[node] : Z[node]);
+      // Left holds keys <= split, right >= split: the far side is at least
+      // |delta| away on this axis.
+      uint32_t nearC = delta < 0.0f ? left : left + 1;
+      uint32_t farC = delta < 0.0f ? left + 1 : left;
+      if (delta * delta <= radius2 && farC < n) stack[sp++] = farC;
+      if (nearC >= n) break;
+      node = nearC;
+    }
+    if (sp == 0) break;
+    node = stack[--sp];
+  }
+  q.count = count;
+  return count;
+}
+
 int KdTree::knn(Vec3f p, int k, float maxRadius2, KnnQuery& q) const {
   TDPM_ASSERT(!spaceTime_, "knn() needs the 3D tree; this one is space-time (use knn4)");
   float key[3] = {p.x, p.y, p.z};

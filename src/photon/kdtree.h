@@ -61,6 +61,24 @@ class KnnQuery {
   std::vector<StackEntry> stack_;  // never deeper than the tree
 };
 
+// Reusable per-thread results of a fixed-radius query (KdTree::range): every
+// photon within the radius, in traversal order. The arrays grow to the
+// largest result seen and are then reused: no allocation per query after
+// warm-up.
+class RangeQuery {
+ public:
+  int count = 0;
+  const uint32_t* index() const { return index_.data(); }
+  const float* dist2() const { return dist2_.data(); }
+  size_t capacity() const { return index_.size(); }
+
+ private:
+  friend class KdTree;
+  void grow();
+  std::vector<uint32_t> index_;
+  std::vector<float> dist2_;
+};
+
 struct KdBuildOptions {
   bool spaceTime = false;  // build the 4D variant
   float kappa = 1.0f;      // 4D metric weight (distance^2 per second^2)
@@ -91,6 +109,10 @@ class KdTree {
   // k nearest in the space-time metric around (p, t) within maxDist2
   // (4D variant): dist2 entries are |dx|^2 + kappa dt^2.
   int knn4(Vec3f p, float t, int k, float maxDist2, KnnQuery& q) const;
+  // Every photon with |x_p - p|^2 <= radius2 (3D variant), into q.
+  // Returns q.count. A plain depth-first walk: the radius never shrinks, so
+  // unlike knn there is no heap and no deferred node test.
+  int range(Vec3f p, float radius2, RangeQuery& q) const;
 
  private:
   template <int D>

@@ -11,6 +11,7 @@
 #include <limits>
 #include <vector>
 
+#include "core/error.h"
 #include "core/rng.h"
 #include "core/timer.h"
 #include "math/frame.h"
@@ -22,7 +23,6 @@ namespace tdpm::photon {
 
 namespace {
 
-constexpr uint32_t kPathsPerBatch = 1024;
 constexpr uint32_t kPilotBatches = 16;
 // Batches traced before they are appended to the result (see traceBatches):
 // enough work to keep every core busy, small next to a large map.
@@ -333,20 +333,30 @@ struct Tracer {
   float t0, t1, ts;
   uint32_t timeScramble;
   float u0 = 0.0f, u1 = 1.0f;  // path times, normalised over the scene's shutter
+  uint64_t batchOffset = 0;    // global index of batch 0 (progressive passes)
 
   // Traces paths [first, first + count) of batch `b` into `out`, energies
   // scaled by `energyScale` (= ts / n_e). Returns nothing: out grows.
   // Returns the number of rays cast.
-  uint64_t traceBatch(uint64_t b, double energyScale, PhotonStore& out) const {
+  uint64_t traceBatch(uint64_t local, double energyScale, PhotonStore& out) const {
+    uint64_t b = batchOffset + local;
     Rng rng(hashCombine(settings.seed, uint64_t(settings.kind) + 1, b), 0x9e37);
     // sobol: the path index is the sample index, the map's seed and kind the "pixel".
     uint64_t sobolSeed = hashCombine(settings.seed, uint64_t(settings.kind) + 1, 0x9407ull);
+    // Sequences are indexed by 32 bits: past 2^32 paths (a long progressive
+    // render) each further 2^32 take new scrambles instead of repeating the
+    // first paths. Below 2^32 nothing changes.
+    uint32_t timeScrambleHere = timeScramble;
+    if (uint64_t high = (b * kPathsPerBatch) >> 32) {
+      sobolSeed = hashCombine(sobolSeed, high);
+      timeScrambleHere ^= uint32_t(mix64(high ^ 0x7173ull));
+    }
     uint64_t rays = 0;
     for (uint32_t i = 0; i < kPathsPerBatch; ++i) {
       uint64_t g = b * kPathsPerBatch + i;
       // The time stays the scrambled van der Corput of the path index for
       // both kinds: it is already a stratified 1D sequence over the shutter.
-      float time01 = settings.spreadInTime ? u0 + scrambledVanDerCorput(uint32_t(g), timeScramble) * (u1 - u0)
+      float time01 = settings.spreadInTime ? u0 + scrambledVanDerCorput(uint32_t(g), timeScrambleHere) * (u1 - u0)
                                             : settings.fixedTime01;
       if (settings.sampler == SamplerKind::Sobol) {
         SobolStream s{sobolSeed, uint32_t(g)};
@@ -504,6 +514,20 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   if (settings.storedWanted == 0 || tracer.lights.empty()) return result;
   if (settings.kind == MapKind::Caustic && !sceneHasSpecular(scene)) return result;
   const char* stage = settings.kind == MapKind::Caustic ? "caustic photons" : "global photons";
+  if (settings.paths > 0) {
+    // A progressive pass: the count is fixed (pass 0's pilot chose it).
+    TDPM_ASSERT(settings.paths % kPathsPerBatch == 0 && settings.firstPath % kPathsPerBatch == 0,
+                "progressive photon paths must be whole batches");
+    tracer.batchOffset = settings.firstPath / kPathsPerBatch;
+    uint64_t batches = settings.paths / kPathsPerBatch;
+    result.emitted = settings.paths;
+    double energyScale = double(tracer.ts) / double(result.emitted);
+    size_t expected = settings.storedWanted + size_t(4.0 * std::sqrt(double(settings.storedWanted))) + 1024;
+    result.store = tracer.traceBatches(0, batches, energyScale, progress, stage, expected, &result.rays);
+    result.store.shrinkToFit();
+    result.seconds = timer.seconds();
+    return result;
+  }
 
   // Pilot: how many photons does a path store on average? Grow the pilot
   // (8x a round) until something is stored or a round would exceed the

@@ -52,7 +52,16 @@ struct TraceSettings {
   // > 0: photons stored per emitted path, measured before (a pilot over the
   // whole timeline): the pilot run is skipped and the emission sized by it.
   double storedPerPath = 0;
+  // Progressive passes (render/progressive.h): paths > 0 traces exactly
+  // that many paths (a multiple of kPathsPerBatch), no pilot, with global
+  // path indices [firstPath, firstPath + paths) (firstPath a multiple of
+  // kPathsPerBatch too): pass i continues the sequences of the passes before.
+  uint64_t firstPath = 0;
+  uint64_t paths = 0;
 };
+
+// Paths per batch: the unit of emission counts and of TraceSettings::firstPath.
+constexpr uint64_t kPathsPerBatch = 1024;
 
 struct TraceResult {
   PhotonStore store;

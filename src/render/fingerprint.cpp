@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "core/rng.h"
+#include "sampling/filter.h"
 #include "sampling/sampler.h"
 #include "scene/json_writer.h"
 
@@ -89,6 +90,10 @@ std::map<std::string, std::string> renderSettings(const RenderOptions& o, int wi
       {"gather", std::to_string(o.gatherRays)},
       {"global_direct", o.visualizeGlobal ? "yes" : "no"},
       {"resolution", std::to_string(width) + "x" + std::to_string(height)},
+      {"filter", filterName(o.filter)},
+      {"filter_radius", floatText(o.filterRadius)},
+      {"kernel_footprint", floatText(o.kernelFootprint)},
+      {"alpha", o.alpha > 0 ? floatText(o.alpha) : "auto"},
   };
 }
 

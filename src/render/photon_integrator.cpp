@@ -36,15 +36,27 @@ EstimateCounts PhotonIntegrator::counts() const { return {standardCount_.load(),
 
 Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::Gatherer>& g,
                                std::unique_ptr<estimate::Gatherer>& g3, const Hit& hit, const ShadingContext& ctx,
-                               Vec3f wo, float time01, bool timeDependent, EstimateCounts& counts,
+                               Vec3f wo, float time01, bool timeDependent, ThreadState& ts,
                                float minVolume) const {
   if (!map || map->size() == 0) return Rgb(0.0f);
+  EstimateCounts& counts = ts.counts;
   auto brdf = [&ctx](Vec3f wi, Vec3f) { return bsdfEval(ctx, wi); };
   Vec3f n = ctx.frame.n;  // faces the viewer: photons from the other side do not count
   // Nor do photons on the other side of this object's surface, which the
   // side test alone lets through convex edges and thin parts of closed
   // objects (photon/surface_tag.h).
   uint8_t tag = photon::surfaceTag(hit.object, dot(hit.n, wo) < 0.0f);
+  if (s_.fixedKernels) {
+    if (!ts.fixed) ts.fixed = std::make_unique<estimate::FixedKernelGatherer>();
+    const estimate::MapKernel& k = map == caustic_ ? s_.causticKernel : s_.globalKernel;
+    if (timeDependent) {
+      ++counts.timeDependent;
+      float t = scene_.shutter.instant() ? map->store.t0() : scene_.shutter.fromNormalized(time01);
+      return ts.fixed->spaceTime(map->tree, hit.p, n, wo, t, k.radius, k.halfWindow, brdf, tag);
+    }
+    ++counts.standard;
+    return ts.fixed->spatial(map->spatialTree(), hit.p, n, wo, k.spatialRadius, brdf, tag);
+  }
   if (timeDependent) {
     ++counts.timeDependent;
     if (!g) {
@@ -97,7 +109,7 @@ Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, flo
       const Material& m = scene_.materials[scene_.objects[h.object].material];
       ShadingContext c = makeShadingContext(m, m.albedo.at(h.localP), h.n, -d);
       if (!m.isDeltaOnly()) {
-        sum += beta * estimate(global_, ts.global, ts.global3, h, c, -d, time01, s_.timeDependent && moved, ts.counts);
+        sum += beta * estimate(global_, ts.global, ts.global3, h, c, -d, time01, s_.timeDependent && moved, ts);
         break;
       }
       BsdfSample sb;
@@ -142,12 +154,12 @@ Rgb PhotonIntegrator::radiance(Vec3f origin, Vec3f dir, float time01, Stream& sa
     if (!mat.isDeltaOnly()) {
       // ---- gather point ----
       if (s_.visualizeGlobal) {
-        L += beta * estimate(global_, ts.global, ts.global3, hit, ctx, -dir, time01, timeDependent, ts.counts);
+        L += beta * estimate(global_, ts.global, ts.global3, hit, ctx, -dir, time01, timeDependent, ts);
         break;
       }
       bool gather = global_ && global_->size() > 0 && s_.gatherRays > 0;
       L += beta * directLight(scene_, hit, ctx, time01, sampler, depth, gather ? s_.gatherRays : 0);
-      L += beta * estimate(caustic_, ts.caustic, ts.caustic3, hit, ctx, -dir, time01, timeDependent, ts.counts,
+      L += beta * estimate(caustic_, ts.caustic, ts.caustic3, hit, ctx, -dir, time01, timeDependent, ts,
                            s_.footprintVolume * pathLength * pathLength);
       if (gather) L += beta * finalGather(hit, ctx, time01, touched, sampler, depth, ts);
       break;

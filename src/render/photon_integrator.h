@@ -16,6 +16,7 @@
 
 #include "core/rng.h"
 #include "estimate/estimators.h"
+#include "estimate/fixed_kernel.h"
 #include "render/photon_map.h"
 #include "sampling/sampler.h"
 #include "scene/scene.h"
@@ -34,6 +35,12 @@ struct PhotonIntegratorSettings {
   // space-time share of one eye sample (pixel area at that distance x
   // shutter / spp, times a scale); 0: none. See estimate/estimators.h.
   float footprintVolume = 0.0f;
+  // Progressive passes (render/progressive.h): every estimate uses the fixed
+  // kernels below (estimate/fixed_kernel.h) instead of the k-NN: the
+  // space-time kernel where the time-dependent estimate applies, the spatial
+  // one over the whole shutter elsewhere (the skip rule).
+  bool fixedKernels = false;
+  estimate::MapKernel causticKernel, globalKernel;
 };
 
 struct EstimateCounts {
@@ -44,6 +51,7 @@ class PhotonIntegrator {
  public:
   struct ThreadState {
     std::unique_ptr<estimate::Gatherer> caustic, caustic3, global, global3;
+    std::unique_ptr<estimate::FixedKernelGatherer> fixed;  // fixedKernels only
     EstimateCounts counts;
   };
 
@@ -64,7 +72,7 @@ class PhotonIntegrator {
  private:
   Rgb estimate(const PhotonMap* map, std::unique_ptr<estimate::Gatherer>& g, std::unique_ptr<estimate::Gatherer>& g3,
                const Hit& hit, const struct ShadingContext& ctx, Vec3f wo, float time01, bool timeDependent,
-               EstimateCounts& counts, float minVolume = 0.0f) const;
+               ThreadState& ts, float minVolume = 0.0f) const;
   template <class Stream>
   Rgb finalGather(const Hit& hit, const struct ShadingContext& ctx, float time01, bool touched, Stream& sampler,
                   int vertex, ThreadState& ts) const;

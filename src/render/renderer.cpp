@@ -21,6 +21,7 @@
 #include "render/memory_budget.h"
 #include "render/photon_map.h"
 #include "render/pixel_share.h"
+#include "render/progressive.h"
 #include "render/tile_loop.h"
 #include "sampling/sampler.h"
 
@@ -367,6 +368,10 @@ bool isRenderMethod(const std::string& name) {
 Film render(const Scene& scene, const RenderOptions& opt, const Progress& progress, RenderStats& st, dist::Comm& comm) {
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
   if (!isRenderMethod(opt.method)) throw Error("unknown method '" + opt.method + "'");
+  if (opt.progressive) {  // render/progressive.h, from pass 0
+    ProgressiveState state;
+    return renderProgressive(scene, opt, state, progress, st);
+  }
   // Before any work: an image or photon budget that cannot fit is an error,
   // not an OOM kill (render/memory_budget.h). Every rank holds the whole
   // photon maps, so every rank checks; one rank short of memory stops all.

@@ -78,6 +78,12 @@ struct RenderOptions {
   std::string globalPhotonsSource = "--global-photons";
   // How the image size was set, for the memory-budget error.
   std::string resolutionSource = "the camera resolution";
+
+  // ---- progressive passes (render/progressive.h): time, accumulation, standard ----
+  bool progressive = false;
+  int passes = 0;                 // stop once this many passes are done in all (0: the time limit decides)
+  double timeLimitSeconds = 0;    // > 0: stop after the pass that reaches it (this run's seconds)
+  float alpha = 0;                // > 0: overrides the variant's alpha (docs/photon-map.md)
 };
 
 struct RenderStats {

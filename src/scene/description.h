@@ -134,6 +134,10 @@ struct RenderSettings {
   std::optional<std::string> kernelSpace; // uniform | cone | epanechnikov
   std::optional<std::string> kernelTime;  // uniform | epanechnikov
   std::optional<int> gather;              // final-gather rays per sample, >= 0
+  // progressive passes (render/progressive.h)
+  std::optional<bool> progressive;
+  std::optional<int> passes;              // >= 1
+  std::optional<float> timeLimit;         // seconds, > 0
 };
 
 // An animation (docs/scene-format.md, "animation"): frame i exposes

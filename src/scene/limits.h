@@ -53,6 +53,7 @@ struct IntRange {
 constexpr IntRange kSpp{1, int64_t(1) << 20};
 constexpr IntRange kMaxDepth{1, 1024};
 constexpr IntRange kFrames{1, 4096};
+constexpr IntRange kPasses{1, int64_t(1) << 24};  // progressive passes
 constexpr IntRange kK{1, 4096};
 constexpr IntRange kGather{0, 1024};
 // 2^31 photons at 20 bytes is 40 GiB: more is certainly a typo.

@@ -681,7 +681,7 @@ const std::vector<std::string> kTimeKernels = {"uniform", "epanechnikov"};
 RenderSettings readRender(const Node& n, float shutterLength) {
   n.expectObject({"method", "spp", "max_spp", "contrast", "seed", "max_depth", "exposure", "photons", "global_photons",
                   "frames", "search", "k", "fraction", "kappa", "max_radius", "max_dt", "kernel_space", "kernel_time",
-                  "gather", "sampler", "filter", "filter_radius"});
+                  "gather", "sampler", "filter", "filter_radius", "progressive", "passes", "time_limit"});
   RenderSettings r;
   if (n.has("method")) r.method = n.member("method").choice(kMethods, "render method");
   if (n.has("spp")) r.spp = readCount(n.member("spp"), "spp", limits::kSpp);
@@ -708,6 +708,13 @@ RenderSettings readRender(const Node& n, float shutterLength) {
   if (n.has("kernel_space")) r.kernelSpace = n.member("kernel_space").choice(kSpaceKernels, "space kernel");
   if (n.has("kernel_time")) r.kernelTime = n.member("kernel_time").choice(kTimeKernels, "time kernel");
   if (n.has("gather")) r.gather = readCount(n.member("gather"), "gather", limits::kGather);
+  if (n.has("progressive")) {
+    Node p = n.member("progressive");
+    p.require(p.json().is_boolean(), "expected true or false");
+    r.progressive = p.json().get<bool>();
+  }
+  if (n.has("passes")) r.passes = readCount(n.member("passes"), "passes", limits::kPasses);
+  if (n.has("time_limit")) r.timeLimit = readPositive(n.member("time_limit"), "time_limit");
   return r;
 }
 

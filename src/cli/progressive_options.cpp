@@ -1,0 +1,125 @@
+// cli/progressive_options.cpp — see progressive_options.h.
+#include "cli/progressive_options.h"
+
+#include <cstdio>
+
+#include "core/error.h"
+#include "render/progressive.h"
+
+namespace tdpm::cli {
+
+namespace {
+std::string g17(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+double scalar(const ProgressiveState& s, const char* key) {
+  auto it = s.scalars.find(key);
+  return it == s.scalars.end() ? 0.0 : it->second;
+}
+}  // namespace
+
+void addProgressiveOptions(CLI::App* c, RenderArgs& a) {
+  const std::string group = "Progressive photon mapping (time, accumulation, standard)";
+  c->add_flag("--progressive", a.progressive,
+              "Render in passes, each with fresh photons and fixed kernels that shrink from pass to pass, averaged "
+              "into the image: converges in the memory of one pass (docs/photon-map.md). Photon counts are per pass; "
+              "--spp is the samples per pixel of each pass. Stops after --passes, or after the pass that reaches "
+              "--time-limit (default: 30 s when neither is given); SIGINT/SIGTERM stop after the current pass and "
+              "write the passes done")
+      ->group(group);
+  c->add_option("--passes", a.passes, "--progressive: stop once this many passes are done")
+      ->check(CLI::Range(1, 1 << 24))->group(group);
+  c->add_option("--time-limit", a.timeLimit,
+                "--progressive: stop after the pass that reaches this many seconds")
+      ->check(CLI::PositiveNumber)->group(group);
+  c->add_option("--alpha", a.alpha,
+                "--progressive: the kernel's shrink per pass, volume_{i+1} = volume_i (i + alpha)/(i + 1), in (0, 1) "
+                "(default 4/7 for time's space-time kernel, 2/3 for the spatial kernel of accumulation and standard)")
+      ->check(CLI::Range(1e-3, 0.999))->group(group);
+}
+
+void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath,
+                             RenderOptions& o) {
+  o.progressive = a.progressive || sc.progressive.value_or(false);
+  if (!o.progressive) {
+    if (a.passes) throw Error("--passes needs --progressive (a fixed-budget render has no passes)");
+    if (a.timeLimit) throw Error("--time-limit needs --progressive (a fixed-budget render has no passes)");
+    if (a.alpha) throw Error("--alpha needs --progressive (a fixed-budget render has no shrinking kernel)");
+    if (sc.passes) throw Error("render.passes in " + sourcePath + " needs render.progressive true or --progressive");
+    if (sc.timeLimit)
+      throw Error("render.time_limit in " + sourcePath + " needs render.progressive true or --progressive");
+    return;
+  }
+  if (!isProgressiveMethod(o.method))
+    throw Error("--progressive works with the methods time, accumulation and standard, not '" + o.method +
+                "' (set by " + (a.method ? std::string("--method") : "render.method in " + sourcePath + " or the default") + ")");
+  // Settings a progressive render does not use: a flag is an error (the
+  // user asked for something that would not happen), a scene key a note
+  // (the scene may be meant for fixed-budget renders too).
+  auto unused = [&](bool flag, bool key, const char* flagName, const char* keyName, const char* why) {
+    if (flag) throw Error(std::string(flagName) + " has no effect with --progressive (" + why + ")");
+    if (key)
+      std::fprintf(stderr, "tdpm: note: render.%s in %s is not used by --progressive (%s)\n", keyName,
+                   sourcePath.c_str(), why);
+  };
+  unused(a.maxSpp && *a.maxSpp > o.spp, sc.maxSpp && *sc.maxSpp > o.spp, "--max-spp", "max_spp",
+         "every pass takes --spp samples per pixel; more passes take more");
+  unused(bool(a.frames), bool(sc.frames), "--frames", "frames",
+         "accumulation --progressive renders one stratified time per pass");
+  unused(a.search && *a.search == "4d", sc.search && *sc.search == "4d", "--search 4d", "search",
+         "the passes gather with fixed kernels, not a k-NN search");
+  unused(a.kernelSpace && *a.kernelSpace != "uniform", sc.kernelSpace && *sc.kernelSpace != "uniform",
+         "--kernel-space", "kernel_space", "the fixed kernels are uniform");
+  unused(a.kernelTime && *a.kernelTime != "uniform", sc.kernelTime && *sc.kernelTime != "uniform", "--kernel-time",
+         "kernel_time", "the fixed kernels are uniform");
+  unused(bool(a.kappa), bool(sc.kappa), "--kappa", "kappa", "it weighs the 4d search, which passes do not use");
+  o.maxSpp = o.spp;
+  if (a.passes) o.passes = *a.passes;
+  else if (sc.passes) o.passes = *sc.passes;
+  if (a.timeLimit) o.timeLimitSeconds = *a.timeLimit;
+  else if (sc.timeLimit) o.timeLimitSeconds = double(*sc.timeLimit);
+  // A flag that sets one limit replaces the scene's other one too.
+  if ((a.passes || a.timeLimit) && !(a.passes && a.timeLimit)) {
+    if (a.passes && !a.timeLimit) o.timeLimitSeconds = 0;
+    if (a.timeLimit && !a.passes) o.passes = 0;
+  }
+  if (a.alpha) o.alpha = *a.alpha;
+}
+
+void addProgressiveMetadata(const ProgressiveState& s, std::map<std::string, std::string>& m) {
+  m["tdpm/progressive"] = "1";
+  m["tdpm/passes"] = std::to_string(s.passesDone);
+  m["tdpm/photons_emitted"] = g17(scalar(s, "photons.emitted"));
+  m["tdpm/photons_stored"] = g17(scalar(s, "photons.stored"));
+  m["tdpm/kernel_radius"] = g17(scalar(s, "kernel.radius"));
+  m["tdpm/kernel_spatial_radius"] = g17(scalar(s, "kernel.spatial_radius"));
+  m["tdpm/kernel_half_window"] = g17(scalar(s, "kernel.half_window"));
+  m["tdpm/progressive_seconds"] = g17(scalar(s, "seconds"));
+  auto a = s.settings.find("alpha");
+  if (a != s.settings.end()) m["tdpm/alpha"] = a->second;
+}
+
+Progress withPassLines(Progress p) {
+  auto previous = p.position;
+  p.position = [previous](const WorkPosition& w) {
+    if (previous) previous(w);
+    if (w.done == 0) return;
+    std::fprintf(stderr, "tdpm: pass %zu%s done, %.4g photon paths emitted in all\n", w.done,
+                 w.total ? (" of " + std::to_string(w.total)).c_str() : "", double(w.photonsEmitted));
+  };
+  return p;
+}
+
+std::string progressiveSummary(const ProgressiveState& s) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "%d passes, %.4g photons emitted (%.4g stored), final kernel radius %.4g (spatial %.4g), half window "
+                "%.4g s, %.2f s of passes",
+                s.passesDone, scalar(s, "photons.emitted"), scalar(s, "photons.stored"), scalar(s, "kernel.radius"),
+                scalar(s, "kernel.spatial_radius"), scalar(s, "kernel.half_window"), scalar(s, "seconds"));
+  return buf;
+}
+
+}  // namespace tdpm::cli

@@ -1,0 +1,39 @@
+// cli/progressive_options.h — the render subcommand's progressive flags
+// (--progressive, --passes, --time-limit, --alpha; scene keys
+// render.progressive, render.passes, render.time_limit), their validation,
+// and what a progressive render adds to the EXR metadata and the summary.
+// Kept apart from render_command.cpp so that the pass loop's CLI is one file.
+#pragma once
+#include <CLI/CLI.hpp>
+#include <map>
+#include <string>
+
+#include "cli/render_command.h"
+#include "core/progress.h"
+#include "render/progressive_state.h"
+#include "render/renderer.h"
+#include "scene/description.h"
+
+namespace tdpm::cli {
+
+void addProgressiveOptions(CLI::App* c, RenderArgs& a);
+
+// Flags over the scene's keys into `o` (after the method is known). Throws
+// tdpm::Error (exit 1) for --passes / --time-limit / --alpha without
+// --progressive (naming the flag or key) and for --progressive with a
+// method that has no progressive variant.
+void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath,
+                             RenderOptions& o);
+
+// "tdpm/passes", "tdpm/photons_emitted", "tdpm/kernel_radius", ... from the state.
+void addProgressiveMetadata(const ProgressiveState& state, std::map<std::string, std::string>& metadata);
+
+// When no progress bar is drawn (stderr not a terminal) and not --quiet:
+// one line per finished pass on stderr, "tdpm: pass N done ...", so logs
+// (and tests waiting to send a signal) see the passes go by.
+Progress withPassLines(Progress p);
+
+// One summary line: passes, photons, final kernel, seconds.
+std::string progressiveSummary(const ProgressiveState& state);
+
+}  // namespace tdpm::cli

@@ -1,0 +1,412 @@
+// render/progressive.cpp — the pass loop of progressive photon mapping
+// (render/progressive.h): one pass = fresh maps, fixed kernels, one batch of
+// eye samples per pixel added into the state's float sums.
+#include "render/progressive.h"
+
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include "core/error.h"
+#include "core/memory.h"
+#include "core/rng.h"
+#include "core/signals.h"
+#include "core/timer.h"
+#include "estimate/estimators.h"
+#include "photon/tracer.h"
+#include "render/memory_budget.h"
+#include "render/photon_integrator.h"
+#include "render/photon_map.h"
+#include "render/tile_loop.h"
+#include "sampling/sampler.h"
+
+namespace tdpm {
+
+namespace {
+
+// Pilot queries per map (pass 0): enough for a stable median, a few ms.
+constexpr size_t kPilotQueries = 1024;
+
+const char* const kLayers[] = {"sum.R", "sum.G", "sum.B", "sumsq.R", "sumsq.G", "sumsq.B", "spp"};
+
+Rgb saturate(Rgb L) {
+  for (int c = 0; c < 3; ++c) {
+    float& v = L[c];
+    if (std::isnan(v)) v = 0.0f;
+    else if (std::isinf(v)) v = v > 0 ? FLT_MAX : -FLT_MAX;
+  }
+  return L;
+}
+
+float maxRadiusOf(const Scene& scene, const RenderOptions& opt) {
+  if (std::isfinite(opt.estimate.maxRadius)) return opt.estimate.maxRadius;
+  float diag = scene.bounds.empty() ? 1.0f : scene.extent();
+  return opt.maxRadiusFraction * diag;
+}
+
+double shutterOf(const Scene& scene) {
+  float t0, t1;
+  photon::photonTimeRange(scene, t0, t1);
+  return double(t1) - double(t0);
+}
+
+double scalarOr(const ProgressiveState& s, const std::string& key, double fallback) {
+  auto it = s.scalars.find(key);
+  return it == s.scalars.end() ? fallback : it->second;
+}
+
+double median(std::vector<double>& v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// Pass 1's kernels of one map from a k-NN pilot on pass 0's photons: the
+// medians, over up to kPilotQueries photons taken evenly from the store, of
+// the k-NN radius (spatial kernel: k = --k photons over the whole shutter)
+// and of the two-pass search's radius and window (space-time kernel: k_s in
+// space, the fraction f nearest in time, at most --max-dt). Photon positions
+// sample the map where its photons are, i.e. weighted by its density: the
+// kernels are sized for where the map's light is (a caustic's own scale,
+// not the dark floor around it).
+estimate::MapKernel pilotKernel(const PhotonMap* map, const Scene& scene, const RenderOptions& opt, bool spaceTime) {
+  estimate::MapKernel k;
+  float maxR = maxRadiusOf(scene, opt);
+  double ts = shutterOf(scene);
+  double maxDt = std::isfinite(opt.estimate.maxTimeDistance) ? double(opt.estimate.maxTimeDistance)
+                                                              : double(opt.maxDtFraction) * ts;
+  k.radius = k.spatialRadius = maxR;
+  k.halfWindow = float(maxDt);
+  if (!map || map->size() == 0) return k;
+  estimate::Options so = opt.estimate;
+  so.method = estimate::Method::Standard;
+  so.maxRadius = maxR;
+  estimate::Gatherer standard(map->tree, so);
+  estimate::Options to = opt.estimate;
+  to.method = estimate::Method::TimeTwoPass;
+  to.maxRadius = maxR;
+  to.maxTimeDistance = float(maxDt);
+  estimate::Gatherer twoPass(map->tree, to);
+  const photon::PhotonStore& s = map->store;
+  size_t m = std::min(kPilotQueries, s.size()), stride = s.size() / m;
+  std::vector<double> rs, rt, ht;
+  estimate::ConstantBrdf brdf{Rgb(1.0f)};
+  estimate::Report rep;
+  for (size_t j = 0; j < m; ++j) {
+    size_t i = j * stride + stride / 2;
+    Vec3f p = s.position(i), n = s.direction(i);
+    standard.standard(p, n, n, brdf, &rep);
+    rs.push_back(double(rep.radius2));
+    if (spaceTime) {
+      twoPass.timeTwoPass(p, n, n, s.time(i), brdf, &rep);
+      if (rep.kept > 0) {
+        rt.push_back(double(rep.radius2));
+        ht.push_back(0.5 * (double(rep.windowHi) - double(rep.windowLo)));
+      }
+    }
+  }
+  k.spatialRadius = float(std::sqrt(median(rs)));
+  if (spaceTime && !rt.empty()) {
+    k.radius = float(std::sqrt(median(rt)));
+    k.halfWindow = float(std::min(median(ht), maxDt));
+  } else {
+    k.radius = k.spatialRadius;
+  }
+  // A degenerate pilot (coincident photons) must not give a zero kernel.
+  float floorR = 1e-6f * scene.extent();
+  k.radius = std::max(k.radius, floorR);
+  k.spatialRadius = std::max(k.spatialRadius, floorR);
+  k.halfWindow = std::max(k.halfWindow, float(ts / photon::kTimeBins));
+  return k;
+}
+
+void storeKernel(ProgressiveState& st, const char* map, const estimate::MapKernel& k) {
+  std::string p = std::string("kernel.") + map + ".";
+  st.scalars[p + "radius_1"] = double(k.radius);
+  st.scalars[p + "half_window_1"] = double(k.halfWindow);
+  st.scalars[p + "spatial_radius_1"] = double(k.spatialRadius);
+}
+
+float mainAlpha(const RenderOptions& opt) {
+  if (opt.alpha > 0) return opt.alpha;
+  return opt.method == "time" ? kAlphaSpaceTime : kAlphaSpatial;
+}
+
+template <class Integrator>
+struct Scratch {
+  typename Integrator::ThreadState state;
+};
+
+// Eye samples [first, first + spp) of every pixel; their mean is added to
+// the sums (one pixel per tile task: no locks, any thread count).
+template <class PixelSampler>
+void renderPassPixels(const Scene& scene, const PhotonIntegrator& integ, const RenderOptions& opt, uint32_t first,
+                      int spp, float fixedTime01, const std::string& stage, const Progress& progress,
+                      ProgressiveState& state) {
+  const int w = scene.camera.width(), h = scene.camera.height();
+  float* sum[3] = {state.layers["sum.R"].data(), state.layers["sum.G"].data(), state.layers["sum.B"].data()};
+  float* sq[3] = {state.layers["sumsq.R"].data(), state.layers["sumsq.G"].data(), state.layers["sumsq.B"].data()};
+  float* count = state.layers["spp"].data();
+  const Camera& cam = scene.camera;
+  forEachTile<Scratch<PhotonIntegrator>>(w, h, stage, progress, [&](const Tile& t, Scratch<PhotonIntegrator>& s) {
+    for (int y = t.y0; y < t.y1; ++y)
+      for (int x = t.x0; x < t.x1; ++x) {
+        size_t idx = size_t(y) * size_t(w) + size_t(x);
+        PixelSampler ps(opt.seed, idx);
+        ps.startBatch(first, spp);
+        double acc[3] = {0, 0, 0};
+        for (uint32_t i = first; i < first + uint32_t(spp); ++i) {
+          CameraSample cs = ps.camera(i);
+          if (fixedTime01 >= 0) cs.time01 = fixedTime01;
+          else if (!scene.hasMotion) cs.time01 = 0.0f;
+          Vec3f o, d;
+          cam.generateRay({float(x) + cs.pixelOffset.x, float(y) + cs.pixelOffset.y}, cs.time01, o, d);
+          typename PixelSampler::Stream stream = ps.stream(i);
+          Rgb L = integ.radiance(o, d, cs.time01, stream, s.state);
+          if (!isFinite(L)) L = saturate(L);
+          for (int c = 0; c < 3; ++c) acc[c] += double(L[c]);
+        }
+        Rgb mean = saturate(Rgb(float(acc[0] / spp), float(acc[1] / spp), float(acc[2] / spp)));
+        for (int c = 0; c < 3; ++c) {
+          sum[c][idx] += mean[c];
+          sq[c][idx] += mean[c] * mean[c];
+        }
+        count[idx] += float(spp);
+      }
+    integ.flush(s.state);
+  });
+}
+
+}  // namespace
+
+bool isProgressiveMethod(const std::string& m) { return m == "time" || m == "accumulation" || m == "standard"; }
+
+double kernelScale(int pass, double alpha, int dims) {
+  double v = 1.0;
+  for (int j = 1; j <= pass; ++j) v *= (double(j) + alpha) / double(j + 1);
+  return std::pow(v, 1.0 / double(dims));
+}
+
+float accumulationPassTime(int pass, uint64_t seed) {
+  uint32_t bits = uint32_t(pass);
+  bits = (bits << 16) | (bits >> 16);
+  bits = ((bits & 0x00ff00ffu) << 8) | ((bits & 0xff00ff00u) >> 8);
+  bits = ((bits & 0x0f0f0f0fu) << 4) | ((bits & 0xf0f0f0f0u) >> 4);
+  bits = ((bits & 0x33333333u) << 2) | ((bits & 0xccccccccu) >> 2);
+  bits = ((bits & 0x55555555u) << 1) | ((bits & 0xaaaaaaaau) >> 1);
+  // Rotation (Cranley-Patterson) by a hash of the seed, mod 1 in 32-bit fixed point.
+  bits += uint32_t(mix64(seed ^ 0xacc0ull) >> 32);
+  return std::min(float(bits >> 8) * 0x1p-24f, 0x1.fffffep-1f);
+}
+
+PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& opt, const Scene& scene, int pass) {
+  const bool time = opt.method == "time";
+  const double alpha = mainAlpha(opt);
+  const double binWidth = shutterOf(scene) / photon::kTimeBins;
+  // time: the space-time kernel (d = 3) takes the main alpha, its spatial
+  // fallback 2/3; the other variants have only the spatial kernel (d = 2).
+  const double s3 = kernelScale(pass, alpha, 3);
+  const double s2 = kernelScale(pass, time ? kAlphaSpatial : alpha, 2);
+  auto one = [&](const char* map) {
+    std::string p = std::string("kernel.") + map + ".";
+    estimate::MapKernel k;
+    double r1 = scalarOr(state, p + "radius_1", 0), h1 = scalarOr(state, p + "half_window_1", 0);
+    double r = r1 * s3, h = h1 * s3;
+    if (h < binWidth && h1 > 0) {
+      // Below one time bin the window cannot resolve more (photon/store.h):
+      // floor it and keep the volume schedule r^2 h in the radius.
+      r *= std::sqrt(h / binWidth);
+      h = binWidth;
+    }
+    k.radius = float(r);
+    k.halfWindow = float(h);
+    k.spatialRadius = float(scalarOr(state, p + "spatial_radius_1", 0) * s2);
+    return k;
+  };
+  return {one("caustic"), one("global")};
+}
+
+void runProgressivePass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
+                        const Progress& progress, RenderStats& st) {
+  Timer timer;
+  const int pass = state.passesDone;
+  const bool accumulation = opt.method == "accumulation";
+  const bool spread = !accumulation && scene.hasMotion;
+  const float passTime = accumulation && scene.hasMotion ? accumulationPassTime(pass, opt.seed) : -1.0f;
+
+  // ---- photons: pass 0 sizes the emission with the tracer's pilot; later
+  //      passes trace the same number of paths at the next path indices ----
+  auto trace = [&](photon::MapKind kind, size_t wanted, const char* key) -> std::unique_ptr<PhotonMap> {
+    PhotonMapSettings ms;
+    ms.trace.kind = kind;
+    ms.trace.seed = opt.seed;
+    ms.trace.maxBounces = opt.maxDepth;
+    ms.trace.spreadInTime = spread;
+    ms.trace.fixedTime01 = passTime >= 0 ? passTime : 0.0f;
+    ms.trace.sampler = opt.sampler;
+    ms.trace.storedWanted = wanted;
+    auto it = state.scalars.find(key);
+    if (it != state.scalars.end()) {
+      uint64_t paths = uint64_t(it->second);
+      if (paths == 0) ms.trace.storedWanted = 0;
+      ms.trace.paths = paths;
+      ms.trace.firstPath = uint64_t(pass) * paths;
+    }
+    std::unique_ptr<PhotonMap> m = buildPhotonMap(scene, ms, progress);
+    if (it == state.scalars.end()) state.scalars[key] = double(m->emitted);
+    st.photonSeconds += m->traceSeconds + m->buildSeconds;
+    if (!m->warning.empty() && pass == 0) st.warnings.push_back(m->warning);
+    return m;
+  };
+  bool wantGlobal = opt.visualizeGlobal || opt.gatherRays > 0;
+  std::unique_ptr<PhotonMap> caustic = trace(photon::MapKind::Caustic, opt.causticPhotons, "photons.caustic_paths_per_pass");
+  std::unique_ptr<PhotonMap> global =
+      trace(photon::MapKind::Global, wantGlobal ? opt.globalPhotons : 0, "photons.global_paths_per_pass");
+
+  // ---- kernels: pass 1's from a k-NN pilot on pass 0's maps ----
+  const bool timeDependent = opt.method == "time" && scene.hasMotion;
+  if (!state.scalars.count("kernel.caustic.radius_1")) {
+    storeKernel(state, "caustic", pilotKernel(caustic.get(), scene, opt, timeDependent));
+    storeKernel(state, "global", pilotKernel(global.get(), scene, opt, timeDependent));
+  }
+  PassKernels k = kernelsForPass(state, opt, scene, pass);
+
+  PhotonIntegratorSettings is;
+  is.timeDependent = timeDependent;
+  is.gatherRays = opt.gatherRays;
+  is.visualizeGlobal = opt.visualizeGlobal;
+  is.maxDepth = opt.maxDepth;
+  is.fixedKernels = true;
+  is.causticKernel = k.caustic;
+  is.globalKernel = k.global;
+  PhotonIntegrator integ(scene, caustic.get(), global.get(), is);
+  std::string stage = "pass " + std::to_string(pass + 1) + " render";
+  uint32_t first = uint32_t(pass) * uint32_t(opt.spp);
+  if (opt.sampler == SamplerKind::Random)
+    renderPassPixels<RandomPixelSampler>(scene, integ, opt, first, opt.spp, passTime, stage, progress, state);
+  else
+    renderPassPixels<SobolPixelSampler>(scene, integ, opt, first, opt.spp, passTime, stage, progress, state);
+
+  EstimateCounts c = integ.counts();
+  st.standardEstimates += c.standard;
+  st.timeEstimates += c.timeDependent;
+  st.causticStored += caustic->size();
+  st.globalStored += global->size();
+  st.causticEmitted += caustic->emitted;
+  st.globalEmitted += global->emitted;
+  size_t n = caustic->size() + global->size();
+  if (n > 0)
+    st.bytesPerPhoton = (caustic->bytesPerPhoton() * double(caustic->size()) +
+                         global->bytesPerPhoton() * double(global->size())) / double(n);
+
+  state.passesDone = pass + 1;
+  auto& sc = state.scalars;
+  sc["photons.emitted"] = scalarOr(state, "photons.emitted", 0) + double(caustic->emitted + global->emitted);
+  sc["photons.stored"] = scalarOr(state, "photons.stored", 0) + double(n);
+  sc["kernel.radius"] = double(timeDependent ? k.caustic.radius : k.caustic.spatialRadius);
+  sc["kernel.spatial_radius"] = double(k.caustic.spatialRadius);
+  sc["kernel.half_window"] = timeDependent ? double(k.caustic.halfWindow) : 0.0;
+  sc["seconds"] = scalarOr(state, "seconds", 0) + timer.seconds();
+}
+
+Film filmFromState(const ProgressiveState& state, int width, int height) {
+  Film film(width, height);
+  const size_t n = size_t(width) * size_t(height);
+  const double p = double(std::max(1, state.passesDone));
+  auto layer = [&](const char* name) -> const std::vector<float>& { return state.layers.at(name); };
+  const std::vector<float>* sum[3] = {&layer("sum.R"), &layer("sum.G"), &layer("sum.B")};
+  const std::vector<float>* sq[3] = {&layer("sumsq.R"), &layer("sumsq.G"), &layer("sumsq.B")};
+  const std::vector<float>& spp = layer("spp");
+  for (size_t i = 0; i < n; ++i) {
+    Rgb mean, var(0.0f);
+    for (int c = 0; c < 3; ++c) {
+      double m = double((*sum[c])[i]) / p;
+      mean[c] = float(m);
+      // Variance of the mean of the pass means (passes are independent).
+      if (state.passesDone >= 2) {
+        double v = (double((*sq[c])[i]) / p - m * m) * p / (p - 1.0) / p;
+        var[c] = float(std::min(std::max(v, 0.0), double(FLT_MAX)));
+      }
+    }
+    film.color[i] = saturate(mean);
+    film.varianceOfMean[i] = saturate(var);
+    film.sampleCount[i] = spp[i];
+  }
+  return film;
+}
+
+Film renderProgressive(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
+                       const Progress& progress, RenderStats& st) {
+  if (!isProgressiveMethod(opt.method))
+    throw Error("--progressive works with the methods time, accumulation and standard, not '" + opt.method + "'");
+  TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
+  // One pass's memory, as a fixed-budget render of the same photon counts
+  // (a fixed-budget accumulation would split them over its frames: a pass
+  // holds them all, as standard does).
+  RenderOptions budget = opt;
+  if (budget.method == "accumulation") budget.method = "standard";
+  checkMemoryBudget(scene, budget, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
+  Timer timer;
+  st = RenderStats{};
+  const int w = scene.camera.width(), h = scene.camera.height();
+  const size_t n = size_t(w) * size_t(h);
+  if (state.empty()) {
+    state.layers.clear();
+    state.scalars.clear();
+  }
+  for (const char* name : kLayers) {
+    std::vector<float>& l = state.layers[name];
+    if (state.empty()) l.assign(n, 0.0f);
+    else if (l.size() != n)
+      throw Error(std::string("progressive state: layer '") + name + "' holds " + std::to_string(l.size()) +
+                  " pixels, the image has " + std::to_string(n) + " (" + std::to_string(w) + "x" + std::to_string(h) + ")");
+  }
+  if (state.settings.empty()) {
+    char a[32];
+    std::snprintf(a, sizeof a, "%.9g", double(mainAlpha(opt)));
+    state.settings = {{"method", opt.method},
+                      {"seed", std::to_string(opt.seed)},
+                      {"sampler", samplerName(opt.sampler)},
+                      {"spp", std::to_string(opt.spp)},
+                      {"photons", std::to_string(opt.causticPhotons)},
+                      {"global_photons", std::to_string(opt.globalPhotons)},
+                      {"alpha", a},
+                      {"max_depth", std::to_string(opt.maxDepth)},
+                      {"gather", std::to_string(opt.gatherRays)},
+                      {"k", std::to_string(opt.estimate.k)},
+                      {"resolution", std::to_string(w) + "x" + std::to_string(h)}};
+  }
+  double limit = opt.timeLimitSeconds;
+  if (opt.passes <= 0 && !(limit > 0)) limit = kDefaultProgressiveSeconds;
+  auto position = [&] {
+    return WorkPosition{"pass", size_t(state.passesDone), size_t(std::max(0, opt.passes)), limit,
+                        uint64_t(scalarOr(state, "photons.emitted", 0))};
+  };
+  progress.at(position());
+  for (;;) {
+    if (opt.passes > 0 && state.passesDone >= opt.passes) break;
+    runProgressivePass(scene, opt, state, progress, st);
+    progress.at(position());
+    if (limit > 0 && timer.seconds() >= limit) break;
+    if (signals::stopRequested()) break;
+  }
+  Film film = filmFromState(state, w, h);
+  st.cameraSamples = 0;
+  st.minSpp = n ? int(film.sampleCount[0]) : 0;
+  st.maxSpp = st.minSpp;
+  for (float c : film.sampleCount) {
+    st.cameraSamples += uint64_t(c);
+    st.minSpp = std::min(st.minSpp, int(c));
+    st.maxSpp = std::max(st.maxSpp, int(c));
+  }
+  st.seconds = timer.seconds();
+  st.peakResidentBytes = peakResidentBytes();
+  return film;
+}
+
+}  // namespace tdpm

@@ -1,0 +1,80 @@
+// render/progressive.h — progressive photon mapping in passes (issue 10,
+// docs/photon-map.md "Progressive passes"). A render is a sequence of
+// passes; pass i (0-based) traces fresh photon maps (global photon path
+// indices continue those of passes 0..i-1), renders eye samples
+// [i spp, (i+1) spp) of every pixel with kernels fixed for the pass
+// (estimate/fixed_kernel.h), and adds the pixel means into running float
+// sums: the image is their mean. Memory is one pass's, whatever the count.
+//
+// Variants (RenderOptions::method):
+//   time          space-time kernel (disc r_i x window h_i) where an eye path
+//                 meets motion, the spatial disc over the whole shutter
+//                 elsewhere (the skip rule); volume shrinks by (i+a)/(i+1).
+//   accumulation  pbrt-v4's PR #441: each pass at one stratified time (a
+//                 rotated radical inverse of the pass index) for all its
+//                 photons and eye samples, spatial disc, its own alpha.
+//   standard      photons over the shutter, time ignored (the wrong baseline).
+//
+// Everything pass i depends on is in the ProgressiveState (pass 0's photon
+// path counts and kernels) or a deterministic function of (options, scene,
+// pass index), so a run of 2N passes and a run of N resumed for N more give
+// bit-identical images; combining states is summation of their layers.
+#pragma once
+#include <string>
+
+#include "core/progress.h"
+#include "estimate/fixed_kernel.h"
+#include "render/film.h"
+#include "render/progressive_state.h"
+#include "render/renderer.h"
+#include "scene/scene.h"
+
+namespace tdpm {
+
+// Without --passes or --time-limit a progressive render stops after the pass
+// that reaches this many seconds.
+constexpr double kDefaultProgressiveSeconds = 30.0;
+
+// The alphas (docs/photon-map.md): 4/(d+4) for a d-dimensional kernel.
+constexpr float kAlphaSpaceTime = 4.0f / 7.0f;  // disc x window, d = 3
+constexpr float kAlphaSpatial = 2.0f / 3.0f;    // disc, d = 2
+
+bool isProgressiveMethod(const std::string& method);
+
+// Both kernels of each map for one pass.
+struct PassKernels {
+  estimate::MapKernel caustic, global;
+};
+
+// Relative size of pass `pass`'s (0-based) kernel to pass 0's, for a kernel
+// of `dims` dimensions whose volume shrinks as V_{j+1} = V_j (j + a)/(j + 1)
+// (j 1-based): (V_{pass+1} / V_1)^(1/dims). Deterministic (a double product).
+double kernelScale(int pass, double alpha, int dims);
+
+// The kernels of pass `pass` from pass 0's (state.scalars "kernel.*_1"),
+// with the half window floored at one photon time bin (shutter / 256; the
+// volume schedule is then kept by the radius).
+PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& opt, const Scene& scene, int pass);
+
+// The accumulation variant's time of pass `pass`, in [0, 1): a radical
+// inverse of the pass index, rotated by a hash of the seed.
+float accumulationPassTime(int pass, uint64_t seed);
+
+// Runs one pass (index state.passesDone) and adds it into `state`.
+void runProgressivePass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
+                        const Progress& progress, RenderStats& stats);
+
+// The pass loop: continues `state` (empty: from pass 0) until opt.passes
+// passes are done in all, or this run has taken opt.timeLimitSeconds (after
+// the pass that reaches it), or core/signals reports a stop request (after
+// the current pass). Without either limit, kDefaultProgressiveSeconds.
+// Throws tdpm::Error for a method other than time, accumulation, standard,
+// or a state whose layers do not match the image size.
+Film renderProgressive(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
+                       const Progress& progress, RenderStats& stats);
+
+// The image of a state: sum / passes, spp, and the variance of the mean of
+// the pass means.
+Film filmFromState(const ProgressiveState& state, int width, int height);
+
+}  // namespace tdpm
