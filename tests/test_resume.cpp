@@ -5,6 +5,7 @@
 // --progressive (exit 1, nothing written).
 #include <doctest/doctest.h>
 
+#include <cstring>
 #include <string>
 
 #include "cli/resume.h"
@@ -169,4 +170,27 @@ TEST_CASE("resume: a fresh progressive render starts at pass 0 with its fingerpr
   ProgressiveState next = cli::initialProgressiveState(&resume, s.scene, s.options);
   CHECK(next.passesDone == 2);
   CHECK(next.fingerprint == fresh.fingerprint);
+}
+
+TEST_CASE("resume: N passes, then N more resumed from the EXR, equal 2N passes in one run, bit for bit") {
+  std::string dir = test::makeTempDir();
+  const std::string base = "render '" + std::string(TDPM_SOURCE_DIR) +
+                           "/scenes/cube-caustic.json' -m time --progressive --resolution 40x30 --spp 1 "
+                           "--photons 4000 --global-photons 1500 -q --seed 5 ";
+  test::CommandResult full = test::runTdpm(base + "-t 2 --passes 4 -o " + dir + "/full.exr");
+  REQUIRE_MESSAGE(full.exitCode == 0, full.output);
+  test::CommandResult half = test::runTdpm(base + "-t 1 --passes 2 -o " + dir + "/part.exr");
+  REQUIRE_MESSAGE(half.exitCode == 0, half.output);
+  image::ExrFile two = image::readExr(dir + "/part.exr");
+  // The output may be the file resumed: it is replaced atomically.
+  test::CommandResult more = test::runTdpm(base + "-t 2 --passes 4 --resume " + dir + "/part.exr -o " + dir + "/part.exr");
+  REQUIRE_MESSAGE(more.exitCode == 0, more.output);
+  image::ExrFile a = image::readExr(dir + "/full.exr"), b = image::readExr(dir + "/part.exr");
+  REQUIRE(a.color.pixels.size() == b.color.pixels.size());
+  CHECK(std::memcmp(a.color.pixels.data(), b.color.pixels.data(), a.color.pixels.size() * sizeof(Rgb)) == 0);
+  CHECK(a.metadata["tdpm/progressive/passes"] == "4");
+  CHECK(b.metadata["tdpm/progressive/passes"] == "4");
+  // ... and the comparison can fail: 2 passes are another image.
+  CHECK(std::memcmp(a.color.pixels.data(), two.color.pixels.data(), a.color.pixels.size() * sizeof(Rgb)) != 0);
+  std::system(("rm -rf '" + dir + "'").c_str());
 }

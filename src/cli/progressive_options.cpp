@@ -67,7 +67,7 @@ void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& s
   unused(a.maxSpp && *a.maxSpp > o.spp, sc.maxSpp && *sc.maxSpp > o.spp, "--max-spp", "max_spp",
          "every pass takes --spp samples per pixel; more passes take more");
   unused(bool(a.frames), bool(sc.frames), "--frames", "frames",
-         "accumulation --progressive renders one stratified time per pass");
+         "passes replace in-between frames: accumulation --progressive renders one stratified time per pass");
   unused(a.search && *a.search == "4d", sc.search && *sc.search == "4d", "--search 4d", "search",
          "the passes gather with fixed kernels, not a k-NN search");
   unused(a.kernelSpace && *a.kernelSpace != "uniform", sc.kernelSpace && *sc.kernelSpace != "uniform",

@@ -18,6 +18,7 @@
 #include "cli/frame_pattern.h"
 #include "cli/progress_bar.h"
 #include "cli/resume.h"
+#include "render/progressive_io.h"
 #include "cli/progressive_options.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
