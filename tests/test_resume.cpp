@@ -142,7 +142,7 @@ TEST_CASE("resume: the command line (needs --progressive, exit 1, nothing writte
   const std::string old = s.write("old.exr", &st, 8, 6);
   const std::string out = s.dir + "/out";
   test::CommandResult r = test::runTdpm("render '" + std::string(TDPM_SOURCE_DIR) + "/scenes/glass-ball.json' --resume '" +
-                                        old + "' -o '" + out + ".exr' --resolution 8x6 --spp 1 -q");
+                                        old + "' -o '" + out + ".exr' --resolution 8x6 --spp 1 -q --fixed-budget");
   CHECK(r.exitCode == 1);
   CHECK(r.output.find("tdpm: error: --resume " + old + " needs --progressive") != std::string::npos);
   CHECK(!test::fileExists(out + ".exr"));

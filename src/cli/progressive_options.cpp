@@ -29,6 +29,10 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a) {
               "--time-limit (default: 30 s when neither is given); SIGINT/SIGTERM stop after the current pass and "
               "write the passes done")
       ->group(group);
+  c->add_flag("--fixed-budget", a.fixedBudget,
+              "Render with one photon budget, not in passes, even when the scene's render block sets "
+              "\"progressive\": true (its passes and time_limit are then not used)")
+      ->excludes("--progressive")->group(group);
   c->add_option("--passes", a.passes, "--progressive: stop once this many passes are done")
       ->check(CLI::Range(1, 1 << 24))->group(group);
   c->add_option("--time-limit", a.timeLimit,
@@ -42,13 +46,21 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a) {
 
 void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath,
                              RenderOptions& o) {
-  o.progressive = a.progressive || sc.progressive.value_or(false);
+  // A scene's "progressive": true is for the photon methods it is meant for:
+  // `-m pathtrace` (or static) on that scene renders as usual, without passes.
+  const bool sceneAsks = !a.fixedBudget && sc.progressive.value_or(false);
+  const bool sceneApplies = sceneAsks && isProgressiveMethod(o.method);
+  o.progressive = a.progressive || sceneApplies;
   if (!o.progressive) {
+    // --fixed-budget (or a method without passes) overrides a scene that asks
+    // for passes: its pass keys go with it.
+    const bool sceneKeysApply = !a.fixedBudget && !sceneAsks;
     if (a.passes) throw Error("--passes needs --progressive (a fixed-budget render has no passes)");
     if (a.timeLimit) throw Error("--time-limit needs --progressive (a fixed-budget render has no passes)");
     if (a.alpha) throw Error("--alpha needs --progressive (a fixed-budget render has no shrinking kernel)");
-    if (sc.passes) throw Error("render.passes in " + sourcePath + " needs render.progressive true or --progressive");
-    if (sc.timeLimit)
+    if (sc.passes && sceneKeysApply)
+      throw Error("render.passes in " + sourcePath + " needs render.progressive true or --progressive");
+    if (sc.timeLimit && sceneKeysApply)
       throw Error("render.time_limit in " + sourcePath + " needs render.progressive true or --progressive");
     return;
   }

@@ -39,6 +39,7 @@ struct RenderArgs {
   bool independentFrames = false;
   // progressive passes (cli/progressive_options.h)
   bool progressive = false;
+  bool fixedBudget = false;  // --fixed-budget: overrides render.progressive of the scene
   std::optional<int> passes;
   std::optional<double> timeLimit;
   std::optional<float> alpha;
