@@ -131,10 +131,19 @@ TEST_CASE("filter: a box of radius 0.5 is the unfiltered sample, wider boxes are
 TEST_CASE("filter: a rendered edge takes the filter's profile, and the image mean stays") {
   const int w = 16, h = 8;
   auto d = edgeScene(w, h);
-  for (SamplerKind sk : {SamplerKind::Random, SamplerKind::Sobol}) {
+  // The path tracer with both samplers, and a progressive photon render (8
+  // passes of 8 samples): every pixel loop draws its positions from the filter.
+  for (int variant = 0; variant < 3; ++variant) {
+    SamplerKind sk = variant == 1 ? SamplerKind::Random : SamplerKind::Sobol;
     RenderOptions o;
     o.method = "pathtrace";
     o.spp = o.maxSpp = 64;
+    if (variant == 2) {
+      o.method = "time";
+      o.progressive = true;
+      o.passes = 8;
+      o.spp = o.maxSpp = 8;
+    }
     o.sampler = sk;
     o.filter = FilterKind::Gaussian;
     Film g = renderOn(d, o, 2);
@@ -156,6 +165,7 @@ TEST_CASE("filter: a rendered edge takes the filter's profile, and the image mea
       double expected = 1.0 - filterCdf(w / 2.0 - (x + 0.5), 1.5);
       double bound = 4 * std::sqrt(expected * (1 - expected) / N) + 1e-6;
       CAPTURE(samplerName(sk));
+      CAPTURE(o.method);
       CAPTURE(x);
       CHECK(std::fabs(col - expected) <= bound);
       CHECK(colBox == (x < w / 2 ? 0.0 : 1.0));  // the box sees no neighbour

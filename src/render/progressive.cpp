@@ -153,6 +153,7 @@ void renderPassPixels(const Scene& scene, const PhotonIntegrator& integ, const R
   float* sq[3] = {state.layers["sumsq.R"].data(), state.layers["sumsq.G"].data(), state.layers["sumsq.B"].data()};
   float* count = state.layers["spp"].data();
   const Camera& cam = scene.camera;
+  const PixelFilter filter = pixelFilterFor(opt);
   forEachTile<Scratch<PhotonIntegrator>>(w, h, stage, progress, [&](const Tile& t, Scratch<PhotonIntegrator>& s) {
     for (int y = t.y0; y < t.y1; ++y)
       for (int x = t.x0; x < t.x1; ++x) {
@@ -165,7 +166,8 @@ void renderPassPixels(const Scene& scene, const PhotonIntegrator& integ, const R
           if (fixedTime01 >= 0) cs.time01 = fixedTime01;
           else if (!scene.hasMotion) cs.time01 = 0.0f;
           Vec3f o, d;
-          cam.generateRay({float(x) + cs.pixelOffset.x, float(y) + cs.pixelOffset.y}, cs.time01, o, d);
+          Vec2f p = filter.sample(cs.pixelOffset);  // filter importance sampling: weight 1
+          cam.generateRay({float(x) + p.x, float(y) + p.y}, cs.time01, o, d);
           typename PixelSampler::Stream stream = ps.stream(i);
           Rgb L = integ.radiance(o, d, cs.time01, stream, s.state);
           if (!isFinite(L)) L = saturate(L);

@@ -102,6 +102,18 @@ struct SamplingPlan {
   float time01Lo = 0.0f, time01Hi = 1.0f;  // animation frames: sample times in this part of the shutter
 };
 
+// The plan every render and every animation frame starts from.
+SamplingPlan samplingPlanFor(const RenderOptions& opt) {
+  SamplingPlan plan;
+  plan.batch = opt.spp;
+  plan.maxSpp = std::max(opt.spp, opt.maxSpp);
+  plan.contrast = opt.contrast;
+  plan.seed = opt.seed;
+  plan.sampler = opt.sampler;
+  plan.filter = pixelFilterFor(opt);
+  return plan;
+}
+
 template <class Integrator>
 struct PixelScratch {
   typename Integrator::ThreadState state;
@@ -359,6 +371,10 @@ void checkPhotonMemory(size_t caustic, size_t global, bool spaceTime4D, int maxD
 
 const char* const* renderMethods() { return kMethods; }
 
+PixelFilter pixelFilterFor(const RenderOptions& opt) {
+  return PixelFilter(opt.filter, opt.filterRadius > 0 ? opt.filterRadius : defaultFilterRadius(opt.filter));
+}
+
 bool isRenderMethod(const std::string& name) {
   for (const char* const* m = kMethods; *m; ++m)
     if (name == *m) return true;
@@ -395,13 +411,7 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
   if (dark > 0 && dark == scene.lights.size() && scene.background.isBlack())
     st.warnings.push_back("every light has zero power and the background is black: the image will be black");
   Film film(scene.camera.width(), scene.camera.height());
-  SamplingPlan plan;
-  plan.batch = opt.spp;
-  plan.maxSpp = std::max(opt.spp, opt.maxSpp);
-  plan.contrast = opt.contrast;
-  plan.seed = opt.seed;
-  plan.sampler = opt.sampler;
-  plan.filter = PixelFilter(opt.filter, opt.filterRadius > 0 ? opt.filterRadius : defaultFilterRadius(opt.filter));
+  SamplingPlan plan = samplingPlanFor(opt);
   // A scene with no motion at all draws no time samples.
   plan.sampleTime = scene.hasMotion;
   plan.comm = &comm;
@@ -477,12 +487,7 @@ Film renderFrame(const Scene& scene, const RenderOptions& opt, const FrameInput&
   Timer timer;
   st = RenderStats{};
   Film film(scene.camera.width(), scene.camera.height());
-  SamplingPlan plan;
-  plan.batch = opt.spp;
-  plan.maxSpp = std::max(opt.spp, opt.maxSpp);
-  plan.contrast = opt.contrast;
-  plan.seed = opt.seed;
-  plan.sampler = opt.sampler;
+  SamplingPlan plan = samplingPlanFor(opt);
   plan.time01Lo = scene.shutter.normalized(frame.shutter.open);
   plan.time01Hi = scene.shutter.normalized(frame.shutter.close);
   if (opt.method == "pathtrace") {

@@ -100,6 +100,11 @@ struct RenderStats {
 };
 
 // Names of the methods the renderer accepts (for validation and --help).
+// The pixel filter the options ask for (its kind's default radius when
+// filterRadius is 0): every pixel loop (fixed budget, progressive pass,
+// animation frame) samples its camera positions from it.
+PixelFilter pixelFilterFor(const RenderOptions& opt);
+
 const char* const* renderMethods();
 bool isRenderMethod(const std::string& name);
 
