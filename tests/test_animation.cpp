@@ -19,6 +19,7 @@
 #include "render/renderer.h"
 #include "scene/parse.h"
 #include "scene/scene.h"
+#include "moving_plane.h"
 #include "scene_fixtures.h"
 
 using namespace tdpm;
@@ -42,30 +43,17 @@ std::string animatedJson(const std::string& animation, const std::string& camera
    "motion": [{"time": 0, "translate": [-1, 0, 0]}, {"time": )" + std::to_string(t1) + R"(, "translate": [1, 0, 0]}]}]})";
 }
 
-constexpr float kIntensity = 10.0f;
-constexpr float kRho = 0.5f;
+constexpr float kIntensity = test::kMovingPlaneIntensity;  // W/sr of the point light
+constexpr float kRho = test::kMovingPlaneRho;
 
 // The moving plane of tests/test_photon_render.cpp as an animation: 4
 // frames at 4 fps (timeline [0, 1]), the plane from y = 0 to y = -1 over
 // the timeline, so frame i sees it between -i/4 and -(i/4 + 1/8).
 scene::SceneDescription planeAnimation() {
-  auto d = test::emptyScene(8, 8);
-  d.camera.position = {0, 3, 0};
-  d.camera.target = {0, 0, 0};
-  d.camera.up = {0, 0, -1};
-  d.camera.fovDegrees = 8;
+  auto d = test::movingPlaneScene(8);
   d.camera.shutterOpen = 0;
   d.camera.shutterClose = 1;
   d.animation = scene::AnimationDesc{4.0, 4, 180.0};
-  d.materials.push_back(test::diffuse(Rgb(kRho)));
-  auto plane = test::quad({6, 6}, {0, 0, 0}, 0);
-  plane.motion = test::translation({0, 0, 0}, {0, -1, 0});
-  d.objects.push_back(plane);
-  scene::LightDesc l;
-  l.type = scene::LightDesc::Type::Point;
-  l.position = {0, 2, 0};
-  l.power = Rgb(4 * kPi * kIntensity);
-  d.lights.push_back(l);
   return d;
 }
 
@@ -85,21 +73,7 @@ scene::SceneDescription planeFrameAlone(int frame) {
 // Exact mean of a pixel over frame [t0, t1]: rho/pi I cos / d^2 at the
 // plane point each sub-pixel ray meets, averaged over sub-pixels and time.
 double analyticPixel(const Camera& cam, const Shutter& sceneShutter, int x, int y, float t0, float t1) {
-  const int g = 6, nt = 32;
-  double sum = 0;
-  for (int j = 0; j < g; ++j)
-    for (int i = 0; i < g; ++i)
-      for (int k = 0; k < nt; ++k) {
-        float t = t0 + (t1 - t0) * (k + 0.5f) / nt;
-        Vec3f o, dir;
-        cam.generateRay({x + (i + 0.5f) / g, y + (j + 0.5f) / g}, sceneShutter.normalized(t), o, dir);
-        float s = (-t - o.y) / dir.y;
-        Vec3f p = o + dir * s;
-        Vec3f toL = Vec3f{0, 2, 0} - p;
-        double d2 = lengthSquared(toL);
-        sum += kRho / kPi * kIntensity * (toL.y / std::sqrt(d2)) / d2;
-      }
-  return sum / (g * g * nt);
+  return test::movingPlanePixel(cam, sceneShutter, x, y, t0, t1, 32);
 }
 
 RenderOptions planeOptions(uint64_t seed) {

@@ -10,56 +10,23 @@
 #include <memory>
 
 #include "render/renderer.h"
+#include "moving_plane.h"
 #include "scene_fixtures.h"
 
 using namespace tdpm;
 
 namespace {
 
-constexpr float kIntensity = 10.0f;  // W/sr of the point light
-constexpr float kRho = 0.5f;
+constexpr float kIntensity = test::kMovingPlaneIntensity;  // W/sr of the point light
+constexpr float kRho = test::kMovingPlaneRho;
 
 // A diffuse plane moving along its normal, from y = 0 down to y = -1 over
 // the shutter [0, 1], under a point light at (0, 2, 0); camera above.
-scene::SceneDescription movingPlane() {
-  auto d = test::emptyScene(8, 8);
-  d.camera.position = {0, 3, 0};
-  d.camera.target = {0, 0, 0};
-  d.camera.up = {0, 0, -1};
-  d.camera.fovDegrees = 8;
-  d.materials.push_back(test::diffuse(Rgb(kRho)));
-  auto plane = test::quad({6, 6}, {0, 0, 0}, 0);
-  plane.motion = test::translation({0, 0, 0}, {0, -1, 0});
-  d.objects.push_back(plane);
-  scene::LightDesc l;
-  l.type = scene::LightDesc::Type::Point;
-  l.position = {0, 2, 0};
-  l.power = Rgb(4 * kPi * kIntensity);
-  d.lights.push_back(l);
-  return d;
-}
+scene::SceneDescription movingPlane() { return test::movingPlaneScene(8); }
 
 // Exact pixel mean: radiance rho/pi * I cos / d^2 of the plane point each
 // sub-pixel ray meets at each time, averaged over a fine grid of both.
-double analyticPixel(const Camera& cam, int x, int y) {
-  const int g = 6, nt = 64;
-  double sum = 0;
-  for (int j = 0; j < g; ++j)
-    for (int i = 0; i < g; ++i)
-      for (int k = 0; k < nt; ++k) {
-        float t = (k + 0.5f) / nt;
-        Vec3f o, dir;
-        cam.generateRay({x + (i + 0.5f) / g, y + (j + 0.5f) / g}, t, o, dir);
-        float planeY = -t;
-        float s = (planeY - o.y) / dir.y;
-        Vec3f p = o + dir * s;
-        Vec3f toL = Vec3f{0, 2, 0} - p;
-        double d2 = lengthSquared(toL);
-        double cosT = toL.y / std::sqrt(d2);
-        sum += kRho / kPi * kIntensity * cosT / d2;
-      }
-  return sum / (g * g * nt);
-}
+double analyticPixel(const Camera& cam, int x, int y) { return test::movingPlanePixel(cam, Shutter{0, 1}, x, y); }
 
 RenderOptions photonOptions(const std::string& method) {
   RenderOptions o;

@@ -15,55 +15,22 @@
 #include "photon/tracer.h"
 #include "render/progressive.h"
 #include "render/renderer.h"
+#include "moving_plane.h"
 #include "scene_fixtures.h"
 
 using namespace tdpm;
 
 namespace {
 
-constexpr float kIntensity = 10.0f;  // W/sr of the point light
-constexpr float kRho = 0.5f;
 
 // The moving plane of tests/test_photon_render.cpp: a diffuse plane moving
 // along its normal from y = 0 to y = -1 over the shutter, a point light at
 // (0, 2, 0), the camera above looking down.
-scene::SceneDescription movingPlane(int res) {
-  auto d = test::emptyScene(res, res);
-  d.camera.position = {0, 3, 0};
-  d.camera.target = {0, 0, 0};
-  d.camera.up = {0, 0, -1};
-  d.camera.fovDegrees = 8;
-  d.materials.push_back(test::diffuse(Rgb(kRho)));
-  auto plane = test::quad({6, 6}, {0, 0, 0}, 0);
-  plane.motion = test::translation({0, 0, 0}, {0, -1, 0});
-  d.objects.push_back(plane);
-  scene::LightDesc l;
-  l.type = scene::LightDesc::Type::Point;
-  l.position = {0, 2, 0};
-  l.power = Rgb(4 * kPi * kIntensity);
-  d.lights.push_back(l);
-  return d;
-}
+scene::SceneDescription movingPlane(int res) { return test::movingPlaneScene(res); }
 
 // Exact pixel mean: radiance rho/pi I cos / d^2 of the plane point each
 // sub-pixel ray meets at each time, averaged over a fine grid of both.
-double analyticPixel(const Camera& cam, int x, int y) {
-  const int g = 6, nt = 64;
-  double sum = 0;
-  for (int j = 0; j < g; ++j)
-    for (int i = 0; i < g; ++i)
-      for (int k = 0; k < nt; ++k) {
-        float t = (k + 0.5f) / nt;
-        Vec3f o, dir;
-        cam.generateRay({x + (i + 0.5f) / g, y + (j + 0.5f) / g}, t, o, dir);
-        float s = (-t - o.y) / dir.y;
-        Vec3f p = o + dir * s;
-        Vec3f toL = Vec3f{0, 2, 0} - p;
-        double d2 = lengthSquared(toL);
-        sum += kRho / kPi * kIntensity * (toL.y / std::sqrt(d2)) / d2;
-      }
-  return sum / (g * g * nt);
-}
+double analyticPixel(const Camera& cam, int x, int y) { return test::movingPlanePixel(cam, Shutter{0, 1}, x, y); }
 
 // The global map seen directly (no final gather, no direct light): the
 // estimate alone, as in test_photon_render.cpp.
