@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "cli/frame_pattern.h"
+#include "cli/path_names.h"
 #include "dist/comm.h"
 #include "cli/progress_bar.h"
 #include "core/atomic_file.h"
@@ -34,23 +35,6 @@ namespace tdpm::cli {
 namespace fs = std::filesystem;
 
 namespace {
-
-bool endsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-std::string directoryOf(const std::string& path) {
-  size_t slash = path.find_last_of('/');
-  if (slash == std::string::npos) return ".";
-  return slash == 0 ? "/" : path.substr(0, slash);
-}
-
-std::string stemOf(const std::string& path) {
-  size_t slash = path.find_last_of('/');
-  std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
-  size_t dot = name.find_last_of('.');
-  return dot == std::string::npos || dot == 0 ? name : name.substr(0, dot);
-}
 
 // Creates `dir` and its parents; names the flag and the directory on failure.
 void makeDirectories(const std::string& dir, const std::string& flag) {

@@ -1,6 +1,7 @@
 // cli/compare_command.cpp — the compare subcommand: flags, validation (every
 // check before any output is written), metrics printout, profile files.
 #include "cli/compare_command.h"
+#include "cli/path_names.h"
 
 #include <unistd.h>
 
@@ -46,16 +47,6 @@ std::string parseCrop(const std::string& text, PixelRect& r) {
     if (x > 1 << 20) return "values must be at most 1048576, got '" + text + "'";
   r = {int(v[0]), int(v[1]), int(v[2]), int(v[3])};
   return "";
-}
-
-std::string directoryOf(const std::string& path) {
-  size_t slash = path.find_last_of('/');
-  if (slash == std::string::npos) return ".";
-  return slash == 0 ? "/" : path.substr(0, slash);
-}
-
-bool endsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 void checkWritable(const std::string& flag, const std::string& path) {

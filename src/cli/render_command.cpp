@@ -16,6 +16,7 @@
 
 #include "cli/animation_command.h"
 #include "cli/frame_pattern.h"
+#include "cli/path_names.h"
 #include "cli/progress_bar.h"
 #include "cli/resume.h"
 #include "render/progressive_io.h"
@@ -71,23 +72,6 @@ std::string methodList() {
   std::string s;
   for (const char* const* m = renderMethods(); *m; ++m) s += std::string(s.empty() ? "" : " | ") + *m;
   return s;
-}
-
-std::string directoryOf(const std::string& path) {
-  size_t slash = path.find_last_of('/');
-  if (slash == std::string::npos) return ".";
-  return slash == 0 ? "/" : path.substr(0, slash);
-}
-
-std::string stemOf(const std::string& path) {
-  size_t slash = path.find_last_of('/');
-  std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
-  size_t dot = name.find_last_of('.');
-  return dot == std::string::npos || dot == 0 ? name : name.substr(0, dot);
-}
-
-bool endsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 // pbrt's Film "filename" (often .exr, .png or .pfm): tdpm writes EXR, so
