@@ -45,10 +45,12 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a) {
 }
 
 void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath,
-                             RenderOptions& o) {
+                             RenderOptions& o, bool defaultAllowed) {
   // A scene's "progressive": true is for the photon methods it is meant for:
   // `-m pathtrace` (or static) on that scene renders as usual, without passes.
-  const bool sceneAsks = !a.fixedBudget && sc.progressive.value_or(false);
+  // Nobody said: a scene rendered with its own photon method renders in passes.
+  const bool byDefault = defaultAllowed && !a.method && !a.fixedBudget && !sc.progressive.has_value();
+  const bool sceneAsks = !a.fixedBudget && sc.progressive.value_or(byDefault);
   const bool sceneApplies = sceneAsks && isProgressiveMethod(o.method);
   o.progressive = a.progressive || sceneApplies;
   if (!o.progressive) {

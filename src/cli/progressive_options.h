@@ -22,8 +22,17 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a);
 // tdpm::Error (exit 1) for --passes / --time-limit / --alpha without
 // --progressive (naming the flag or key) and for --progressive with a
 // method that has no progressive variant.
+//
+// The default (neither --progressive, --fixed-budget nor render.progressive
+// given): a scene rendered with its own method — render.method, or the
+// default `time` when it names none — renders progressively when that method
+// has passes (time, accumulation, standard), with the default 30 s limit
+// unless --passes or --time-limit say otherwise. `defaultAllowed` is false
+// where passes are not available (an animation's frames; a job under mpirun
+// until progressive passes are distributed): such renders keep one budget.
+// A method chosen with -m keeps one budget unless --progressive asks.
 void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath,
-                             RenderOptions& o);
+                             RenderOptions& o, bool defaultAllowed = true);
 
 // "tdpm/passes", "tdpm/photons_emitted", "tdpm/kernel_radius", ... from the state.
 void addProgressiveMetadata(const ProgressiveState& state, std::map<std::string, std::string>& metadata);

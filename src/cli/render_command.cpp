@@ -450,7 +450,9 @@ int runRender(const RenderArgs& a) {
       if (o.shape.type == scene::ShapeDesc::Type::Mesh)
         refuseOverwritingInput(output, preview, o.shape.meshFile, "the mesh file of object '" + o.name + "'");
   opt = mergeOptions(a, desc.render, a.scene);
-  mergeProgressiveOptions(a, desc.render, a.scene, opt);
+  // Passes by default where they are available: not for an animation's
+  // frames, nor yet under mpirun (docs/distributed.md).
+  mergeProgressiveOptions(a, desc.render, a.scene, opt, !desc.animation && !comm.distributed());
   checkResumeFlags(a.resume ? &*a.resume : nullptr, opt.progressive);
   exposure = pick(a.exposure, desc.render.exposure, 0.0f);
   if (a.resolution) {
