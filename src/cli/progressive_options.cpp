@@ -41,7 +41,7 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a) {
 }
 
 void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath,
-                             RenderOptions& o) {
+                             RenderOptions& o, bool printNotes) {
   o.progressive = a.progressive || sc.progressive.value_or(false);
   if (!o.progressive) {
     if (a.passes) throw Error("--passes needs --progressive (a fixed-budget render has no passes)");
@@ -60,7 +60,7 @@ void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& s
   // (the scene may be meant for fixed-budget renders too).
   auto unused = [&](bool flag, bool key, const char* flagName, const char* keyName, const char* why) {
     if (flag) throw Error(std::string(flagName) + " has no effect with --progressive (" + why + ")");
-    if (key)
+    if (key && printNotes)
       std::fprintf(stderr, "tdpm: note: render.%s in %s is not used by --progressive (%s)\n", keyName,
                    sourcePath.c_str(), why);
   };

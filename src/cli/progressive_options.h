@@ -21,9 +21,10 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a);
 // Flags over the scene's keys into `o` (after the method is known). Throws
 // tdpm::Error (exit 1) for --passes / --time-limit / --alpha without
 // --progressive (naming the flag or key) and for --progressive with a
-// method that has no progressive variant.
+// method that has no progressive variant. Notes on unused scene keys go to
+// stderr when `printNotes` (under mpirun: rank 0 only).
 void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath,
-                             RenderOptions& o);
+                             RenderOptions& o, bool printNotes = true);
 
 // "tdpm/passes", "tdpm/photons_emitted", "tdpm/kernel_radius", ... from the state.
 void addProgressiveMetadata(const ProgressiveState& state, std::map<std::string, std::string>& metadata);
