@@ -27,12 +27,14 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a) {
               "into the image: converges in the memory of one pass (docs/photon-map.md). Photon counts are per pass; "
               "--spp is the samples per pixel of each pass. Stops after --passes, or after the pass that reaches "
               "--time-limit (default: 30 s when neither is given); SIGINT/SIGTERM stop after the current pass and "
-              "write the passes done")
+              "write the passes done. Under mpirun each rank runs its own passes, one per rank per round, and the "
+              "image equals one process's with the same passes (docs/distributed.md)")
       ->group(group);
   c->add_option("--passes", a.passes, "--progressive: stop once this many passes are done")
       ->check(CLI::Range(1, 1 << 24))->group(group);
   c->add_option("--time-limit", a.timeLimit,
-                "--progressive: stop after the pass that reaches this many seconds")
+                "--progressive: stop after the pass that reaches this many seconds (under mpirun: after the round of "
+                "passes that reaches it)")
       ->check(CLI::PositiveNumber)->group(group);
   c->add_option("--alpha", a.alpha,
                 "--progressive: the kernel's shrink per pass, volume_{i+1} = volume_i (i + alpha)/(i + 1), in (0, 1) "
