@@ -7,6 +7,7 @@
 #include <doctest/doctest.h>
 
 #include <cstring>
+#include <map>
 #include <string>
 
 #include "cli_harness.h"
@@ -71,6 +72,42 @@ void checkSameImage(const std::string& method, const std::string& extra, int ran
   CommandResult other = test::runTdpm(args + " --seed 8 -t 2 -o " + dir + "/other.exr");
   REQUIRE(other.exitCode == 0);
   CHECK_FALSE(sameBits(a, image::readExr(dir + "/other.exr")));
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
+// The state a progressive render leaves in its EXR besides the layers
+// (sameBits covers those): passes and every scalar but the seconds taken.
+std::map<std::string, std::string> progressiveAttributes(const image::ExrFile& f) {
+  std::map<std::string, std::string> m;
+  for (const auto& [k, v] : f.metadata)
+    if (k.rfind("tdpm/progressive/", 0) == 0 && k != "tdpm/progressive/scalar/seconds") m[k] = v;
+  return m;
+}
+
+// A progressive `time` render of the caustic cube, small: 48x32, 2 spp a pass.
+std::string progressiveArgs() {
+  return "render '" + std::string(TDPM_SOURCE_DIR) + "/scenes/cube-caustic.json' -m time --progressive"
+         " --resolution 48x32 --spp 2 --photons 4000 --global-photons 1000 --seed 7 -q ";
+}
+
+// mpirun -np `ranks` with --passes `passes` equals one process, layers of
+// the state included; a run with one pass fewer differs (the check can fail).
+void checkSameProgressive(int ranks, int passes) {
+  std::string dir = test::makeTempDir();
+  std::string p = "--passes " + std::to_string(passes);
+  CommandResult one = test::runTdpm(progressiveArgs() + p + " -t 2 -o " + dir + "/one.exr");
+  REQUIRE_MESSAGE(one.exitCode == 0, one.output);
+  CommandResult many = runMpi(ranks, "", progressiveArgs() + p + " -t 1 -o " + dir + "/many.exr");
+  REQUIRE_MESSAGE(many.exitCode == 0, many.output);
+  image::ExrFile a = image::readExr(dir + "/one.exr"), b = image::readExr(dir + "/many.exr");
+  CHECK(b.metadata["tdpm/progressive/passes"] == std::to_string(passes));
+  CHECK(a.extra.size() >= 7);  // the state's layers ride in the EXR
+  CHECK_MESSAGE(sameBits(a, b), ranks << " ranks, " << passes << " passes differ from one process");
+  CHECK(progressiveAttributes(a) == progressiveAttributes(b));
+  CommandResult fewer = test::runTdpm(progressiveArgs() + "--passes " + std::to_string(passes - 1) + " -t 2 -o " +
+                                      dir + "/fewer.exr");
+  REQUIRE(fewer.exitCode == 0);
+  CHECK_FALSE(sameBits(a, image::readExr(dir + "/fewer.exr")));
   std::system(("rm -rf '" + dir + "'").c_str());
 }
 
@@ -178,6 +215,44 @@ TEST_CASE("mpi: 2 ranks split an animation's frames, each frame bit-identical to
   CHECK(occurrences(bad.output, "--frame-range") == 1);
   CHECK(occurrences(bad.output, "rank-exit 1") == 2);
   CHECK_FALSE(test::fileExists(dir + "/bad/f_000.exr"));
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
+TEST_CASE("mpi: 2 ranks render 5 progressive passes bit-identical to one process (state layers included)") {
+  checkSameProgressive(2, 5);
+}
+
+TEST_CASE("mpi: 3 ranks render 4 progressive passes bit-identical to one process (a short last round)") {
+  checkSameProgressive(3, 4);
+}
+
+TEST_CASE("mpi: progressive under mpirun resumes a one-process state, and stops on the time limit after a round") {
+  std::string dir = test::makeTempDir();
+  CommandResult five = test::runTdpm(progressiveArgs() + "--passes 5 -t 2 -o " + dir + "/five.exr");
+  REQUIRE_MESSAGE(five.exitCode == 0, five.output);
+  CommandResult two = test::runTdpm(progressiveArgs() + "--passes 2 -t 2 -o " + dir + "/two.exr");
+  REQUIRE_MESSAGE(two.exitCode == 0, two.output);
+  // 2 passes alone, then 3 more on 2 ranks (a full round and a short one).
+  CommandResult resumed =
+      runMpi(2, "", progressiveArgs() + "--passes 5 --resume " + dir + "/two.exr -t 1 -o " + dir + "/resumed.exr");
+  REQUIRE_MESSAGE(resumed.exitCode == 0, resumed.output);
+  image::ExrFile a = image::readExr(dir + "/five.exr"), b = image::readExr(dir + "/resumed.exr");
+  CHECK(b.metadata["tdpm/progressive/passes"] == "5");
+  CHECK(sameBits(a, b));
+  CHECK(progressiveAttributes(a) == progressiveAttributes(b));
+  // A time limit every pass exceeds: the job stops after its first round,
+  // which holds one pass per rank, and writes them.
+  CommandResult limited = runMpi(2, "", progressiveArgs() + "--time-limit 1e-9 -t 1 -o " + dir + "/limited.exr");
+  REQUIRE_MESSAGE(limited.exitCode == 0, limited.output);
+  image::ExrFile c = image::readExr(dir + "/limited.exr");
+  CHECK(c.metadata["tdpm/progressive/passes"] == "2");
+  CHECK(sameBits(image::readExr(dir + "/two.exr"), c));
+  // A bad --resume file: one message, every rank exits 1.
+  CommandResult bad = runMpi(2, "", progressiveArgs() + "--resume " + dir + "/missing.exr -t 1 -o " + dir + "/bad.exr",
+                             true);
+  CHECK(occurrences(bad.output, "tdpm: error: --resume " + dir + "/missing.exr") == 1);
+  CHECK(occurrences(bad.output, "rank-exit 1") == 2);
+  CHECK_FALSE(test::fileExists(dir + "/bad.exr"));
   std::system(("rm -rf '" + dir + "'").c_str());
 }
 

@@ -122,11 +122,14 @@ TEST_CASE("progressive cli: flags that need --progressive, and methods without a
   std::string dir = test::makeTempDir();
   std::string scene = writeScene(dir, "s.json", "16, 12", 2000, 1000);
   std::string out = " -o '" + dir + "/o.exr'";
-  for (const char* flag : {"--passes 3", "--time-limit 1", "--alpha 0.5"}) {
-    auto r = runTdpm("render '" + scene + "' " + flag + out);
+  // A method chosen with -m (or --fixed-budget) keeps one budget: pass flags are errors.
+  for (const char* flag : {"--passes 3", "--time-limit 1", "--alpha 0.5", "--fixed-budget --passes 3"}) {
+    auto r = runTdpm("render '" + scene + "' -m time " + flag + out);
     CAPTURE(r.output);
     CHECK(r.exitCode == 1);
-    std::string name = std::string(flag).substr(0, std::string(flag).find(' '));
+    std::string f = std::string(flag);
+    if (f.rfind("--fixed-budget ", 0) == 0) f = f.substr(15);
+    std::string name = f.substr(0, f.find(' '));
     CHECK(contains(r.output, name + " needs --progressive"));
   }
   for (const char* method : {"pathtrace", "static"}) {
@@ -143,9 +146,10 @@ TEST_CASE("progressive cli: flags that need --progressive, and methods without a
     CHECK(contains(r.output, "has no effect with --progressive"));
   }
   auto help = runTdpm("render --help");
-  for (const char* flag : {"--progressive", "--passes", "--time-limit", "--alpha"}) CHECK(contains(help.output, flag));
+  for (const char* flag : {"--progressive", "--fixed-budget", "--passes", "--time-limit", "--alpha"})
+    CHECK(contains(help.output, flag));
   std::string keyed = writeScene(dir, "k.json", "16, 12", 2000, 1000, ", \"passes\": 2");
-  auto k = runTdpm("render '" + keyed + "'" + out);
+  auto k = runTdpm("render '" + keyed + "' -m time" + out);
   CHECK(k.exitCode == 1);
   CHECK(contains(k.output, "render.passes in"));
   CHECK(test::countEntries(dir) == 2);  // the two scenes: no output written
@@ -203,4 +207,25 @@ TEST_CASE("progressive cli: SIGINT stops after the current pass and writes the p
     CHECK(!test::fileExists(dir + "/p.exr"));
     CHECK(!test::fileExists(dir + "/p.png"));
   }
+}
+
+TEST_CASE("progressive cli: a scene rendered with its own photon method renders in passes by default") {
+  std::string dir = test::makeTempDir();
+  std::string scene = writeScene(dir, "s.json", "16, 12", 2000, 1000);
+  // Its own method (render.method time), nobody said otherwise: passes (here 2, not the 30 s limit).
+  auto p = runTdpm("render '" + scene + "' --passes 2 -t 2 -q -o '" + dir + "/p.exr'");
+  REQUIRE_MESSAGE(p.exitCode == 0, p.output);
+  CHECK(image::readExr(dir + "/p.exr").metadata["tdpm/passes"] == "2");
+  // --fixed-budget, or a method chosen with -m: one budget, no passes.
+  for (const char* flag : {"--fixed-budget", "-m time", "-m accumulation"}) {
+    auto f = runTdpm("render '" + scene + "' " + flag + " -t 2 -q -o '" + dir + "/f.exr'");
+    REQUIRE_MESSAGE(f.exitCode == 0, f.output);
+    CHECK(image::readExr(dir + "/f.exr").metadata.count("tdpm/passes") == 0);
+  }
+  // render.progressive false in the scene: one budget too.
+  std::string fixedScene = writeScene(dir, "f.json", "16, 12", 2000, 1000, ", \"progressive\": false");
+  auto g = runTdpm("render '" + fixedScene + "' -t 2 -q -o '" + dir + "/g.exr'");
+  REQUIRE_MESSAGE(g.exitCode == 0, g.output);
+  CHECK(image::readExr(dir + "/g.exr").metadata.count("tdpm/passes") == 0);
+  std::system(("rm -rf '" + dir + "'").c_str());
 }

@@ -27,7 +27,8 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a) {
               "into the image: converges in the memory of one pass (docs/photon-map.md). Photon counts are per pass; "
               "--spp is the samples per pixel of each pass. Stops after --passes, or after the pass that reaches "
               "--time-limit (default: 30 s when neither is given); SIGINT/SIGTERM stop after the current pass and "
-              "write the passes done")
+              "write the passes done. Under mpirun each rank runs its own passes, one per rank per round, and the "
+              "image equals one process's with the same passes (docs/distributed.md)")
       ->group(group);
   c->add_flag("--fixed-budget", a.fixedBudget,
               "Render with one photon budget, not in passes, even when the scene's render block sets "
@@ -36,7 +37,8 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a) {
   c->add_option("--passes", a.passes, "--progressive: stop once this many passes are done")
       ->check(CLI::Range(1, 1 << 24))->group(group);
   c->add_option("--time-limit", a.timeLimit,
-                "--progressive: stop after the pass that reaches this many seconds")
+                "--progressive: stop after the pass that reaches this many seconds (under mpirun: after the round of "
+                "passes that reaches it)")
       ->check(CLI::PositiveNumber)->group(group);
   c->add_option("--alpha", a.alpha,
                 "--progressive: the kernel's shrink per pass, volume_{i+1} = volume_i (i + alpha)/(i + 1), in (0, 1) "
@@ -45,7 +47,7 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a) {
 }
 
 void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath,
-                             RenderOptions& o, bool defaultAllowed) {
+                             RenderOptions& o, bool defaultAllowed, bool printNotes) {
   // A scene's "progressive": true is for the photon methods it is meant for:
   // `-m pathtrace` (or static) on that scene renders as usual, without passes.
   // Nobody said: a scene rendered with its own photon method renders in passes.
@@ -74,7 +76,7 @@ void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& s
   // (the scene may be meant for fixed-budget renders too).
   auto unused = [&](bool flag, bool key, const char* flagName, const char* keyName, const char* why) {
     if (flag) throw Error(std::string(flagName) + " has no effect with --progressive (" + why + ")");
-    if (key)
+    if (key && printNotes)
       std::fprintf(stderr, "tdpm: note: render.%s in %s is not used by --progressive (%s)\n", keyName,
                    sourcePath.c_str(), why);
   };

@@ -28,11 +28,12 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a);
 // default `time` when it names none — renders progressively when that method
 // has passes (time, accumulation, standard), with the default 30 s limit
 // unless --passes or --time-limit say otherwise. `defaultAllowed` is false
-// where passes are not available (an animation's frames; a job under mpirun
-// until progressive passes are distributed): such renders keep one budget.
-// A method chosen with -m keeps one budget unless --progressive asks.
+// where passes are not available (an animation's frames): such renders keep
+// one budget. A method chosen with -m keeps one budget unless --progressive
+// asks. Notes on unused scene keys go to stderr when `printNotes` (under
+// mpirun: rank 0 only).
 void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath,
-                             RenderOptions& o, bool defaultAllowed = true);
+                             RenderOptions& o, bool defaultAllowed = true, bool printNotes = true);
 
 // "tdpm/passes", "tdpm/photons_emitted", "tdpm/kernel_radius", ... from the state.
 void addProgressiveMetadata(const ProgressiveState& state, std::map<std::string, std::string>& metadata);

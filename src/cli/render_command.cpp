@@ -450,9 +450,8 @@ int runRender(const RenderArgs& a) {
       if (o.shape.type == scene::ShapeDesc::Type::Mesh)
         refuseOverwritingInput(output, preview, o.shape.meshFile, "the mesh file of object '" + o.name + "'");
   opt = mergeOptions(a, desc.render, a.scene);
-  // Passes by default where they are available: not for an animation's
-  // frames, nor yet under mpirun (docs/distributed.md).
-  mergeProgressiveOptions(a, desc.render, a.scene, opt, !desc.animation && !comm.distributed());
+  // Passes by default where they are available: not for an animation's frames.
+  mergeProgressiveOptions(a, desc.render, a.scene, opt, !desc.animation, comm.root());
   checkResumeFlags(a.resume ? &*a.resume : nullptr, opt.progressive);
   exposure = pick(a.exposure, desc.render.exposure, 0.0f);
   if (a.resolution) {
@@ -475,13 +474,20 @@ int runRender(const RenderArgs& a) {
   // updates it and the output EXR carries it (docs/resume.md).
   ProgressiveState progressiveState;
   if (opt.progressive) {
-    // Not yet split over ranks (docs/distributed.md), nor run per frame.
-    if (comm.distributed())
-      throw dist::AgreedError("--progressive: progressive rendering under mpirun is not supported yet; run it as one process");
+    // Not yet run per frame (every rank sees the same scene: an agreed error).
     if (desc.animation)
-      throw Error("--progressive: an animation's frames are rendered with a fixed photon budget; progressive frames are "
+      throw dist::AgreedError("--progressive: an animation's frames are rendered with a fixed photon budget; progressive frames are "
                   "not supported yet (leave out --progressive, or render.progressive in " + a.scene + ")");
-    progressiveState = initialProgressiveState(a.resume ? &*a.resume : nullptr, desc, opt);
+    // Under mpirun rank 0 alone reads --resume and holds the state; the
+    // pass loop sends the others what they need (render/progressive.h).
+    std::string resumeError;
+    try {
+      if (comm.root()) progressiveState = initialProgressiveState(a.resume ? &*a.resume : nullptr, desc, opt);
+    } catch (const Error& e) {
+      if (!comm.distributed()) throw;
+      resumeError = e.what();
+    }
+    dist::raiseIfAnyFailed(comm, resumeError);
   }
 
   if (desc.animation) return runAnimation(a, desc, opt, exposure);
@@ -508,7 +514,8 @@ int runRender(const RenderArgs& a) {
   if (opt.progressive) signals::setMode(signals::Mode::Stop);
   bool passLines = opt.progressive && !a.quiet && !ProgressBar::shouldShow(a.quiet);
   Film film = opt.progressive ? renderProgressive(*scene, opt, progressiveState,
-                                                  passLines ? withPassLines(bar.progress()) : bar.progress(), stats)
+                                                  passLines ? withPassLines(bar.progress()) : bar.progress(), stats,
+                                                  comm)
                               : render(*scene, opt, bar.progress(), stats, comm);
   bar.finish();
   // --stats: every rank's communication, gathered before rank 0 writes.

@@ -9,6 +9,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -17,6 +18,7 @@
 #include "core/rng.h"
 #include "core/signals.h"
 #include "core/timer.h"
+#include "dist/comm.h"
 #include "estimate/estimators.h"
 #include "photon/tracer.h"
 #include "render/memory_budget.h"
@@ -142,16 +144,16 @@ struct Scratch {
   typename Integrator::ThreadState state;
 };
 
-// Eye samples [first, first + spp) of every pixel; their mean is added to
-// the sums (one pixel per tile task: no locks, any thread count).
+// Eye samples [first, first + spp) of every pixel; their mean goes to
+// `mean` (3 floats a pixel, one pixel per tile task: no locks, any thread
+// count). addPass adds it into the sums.
 template <class PixelSampler>
 void renderPassPixels(const Scene& scene, const PhotonIntegrator& integ, const RenderOptions& opt, uint32_t first,
                       int spp, float fixedTime01, const std::string& stage, const Progress& progress,
-                      ProgressiveState& state) {
+                      std::vector<float>& mean) {
   const int w = scene.camera.width(), h = scene.camera.height();
-  float* sum[3] = {state.layers["sum.R"].data(), state.layers["sum.G"].data(), state.layers["sum.B"].data()};
-  float* sq[3] = {state.layers["sumsq.R"].data(), state.layers["sumsq.G"].data(), state.layers["sumsq.B"].data()};
-  float* count = state.layers["spp"].data();
+  mean.assign(size_t(w) * size_t(h) * 3, 0.0f);
+  float* out = mean.data();
   const Camera& cam = scene.camera;
   const PixelFilter filter = pixelFilterFor(opt);
   forEachTile<Scratch<PhotonIntegrator>>(w, h, stage, progress, [&](const Tile& t, Scratch<PhotonIntegrator>& s) {
@@ -173,15 +175,175 @@ void renderPassPixels(const Scene& scene, const PhotonIntegrator& integ, const R
           if (!isFinite(L)) L = saturate(L);
           for (int c = 0; c < 3; ++c) acc[c] += double(L[c]);
         }
-        Rgb mean = saturate(Rgb(float(acc[0] / spp), float(acc[1] / spp), float(acc[2] / spp)));
-        for (int c = 0; c < 3; ++c) {
-          sum[c][idx] += mean[c];
-          sq[c][idx] += mean[c] * mean[c];
-        }
-        count[idx] += float(spp);
+        Rgb m = saturate(Rgb(float(acc[0] / spp), float(acc[1] / spp), float(acc[2] / spp)));
+        for (int c = 0; c < 3; ++c) out[3 * idx + size_t(c)] = m[c];
       }
     integ.flush(s.state);
   });
+}
+
+// What one pass adds to the state besides its pixel means, as doubles in a
+// fixed order (they cross the network under mpirun; counts stay exact
+// below 2^53).
+struct PassFigures {
+  double causticStored = 0, globalStored = 0, causticEmitted = 0, globalEmitted = 0;
+  double standardEstimates = 0, timeEstimates = 0, photonSeconds = 0, bytesPerPhoton = 0, seconds = 0;
+  static constexpr size_t kCount = 9;
+  std::vector<double> pack() const {
+    return {causticStored, globalStored, causticEmitted, globalEmitted, standardEstimates,
+            timeEstimates, photonSeconds, bytesPerPhoton, seconds};
+  }
+  static PassFigures unpack(const double* v) {
+    PassFigures f;
+    f.causticStored = v[0], f.globalStored = v[1], f.causticEmitted = v[2], f.globalEmitted = v[3];
+    f.standardEstimates = v[4], f.timeEstimates = v[5], f.photonSeconds = v[6], f.bytesPerPhoton = v[7];
+    f.seconds = v[8];
+    return f;
+  }
+};
+
+// The scalars pass 0 fixes for every later pass (paths per pass from the
+// tracer's pilot, pass 1's kernels from the k-NN pilot): what the other
+// ranks need before their first pass.
+const char* const kPilotScalars[] = {"photons.caustic_paths_per_pass",  "photons.global_paths_per_pass",
+                                     "kernel.caustic.radius_1",         "kernel.caustic.half_window_1",
+                                     "kernel.caustic.spatial_radius_1", "kernel.global.radius_1",
+                                     "kernel.global.half_window_1",     "kernel.global.spatial_radius_1"};
+constexpr size_t kPilotCount = sizeof kPilotScalars / sizeof kPilotScalars[0];
+
+bool hasPilot(const ProgressiveState& s) { return s.scalars.count("kernel.caustic.radius_1") > 0; }
+
+// Rank 0's pilot scalars into every rank's state (collective).
+void sharePilot(dist::Comm& comm, ProgressiveState& s) {
+  double v[kPilotCount] = {};
+  if (comm.root())
+    for (size_t i = 0; i < kPilotCount; ++i) v[i] = scalarOr(s, kPilotScalars[i], 0);
+  comm.broadcast(v, sizeof v, 0);
+  for (size_t i = 0; i < kPilotCount; ++i) s.scalars[kPilotScalars[i]] = v[i];
+}
+
+// Renders pass `pass` into `mean` (3 floats a pixel) without touching the
+// sums. Reads the pilot scalars from `state`, or (pass 0 of a new render)
+// computes them into it and then calls `afterPilot` (may be empty). Only
+// warnings go to `st`; the rest is in the figures, for addPass.
+PassFigures computePass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state, int pass,
+                        const Progress& progress, RenderStats& st, std::vector<float>& mean,
+                        const std::function<void()>& afterPilot) {
+  Timer timer;
+  const bool accumulation = opt.method == "accumulation";
+  const bool spread = !accumulation && scene.hasMotion;
+  const float passTime = accumulation && scene.hasMotion ? accumulationPassTime(pass, opt.seed) : -1.0f;
+
+  double photonSeconds = 0;
+  // ---- photons: pass 0 sizes the emission with the tracer's pilot; later
+  //      passes trace the same number of paths at the next path indices ----
+  auto trace = [&](photon::MapKind kind, size_t wanted, const char* key) -> std::unique_ptr<PhotonMap> {
+    PhotonMapSettings ms;
+    ms.trace.kind = kind;
+    ms.trace.seed = opt.seed;
+    ms.trace.maxBounces = opt.maxDepth;
+    ms.trace.spreadInTime = spread;
+    ms.trace.fixedTime01 = passTime >= 0 ? passTime : 0.0f;
+    ms.trace.sampler = opt.sampler;
+    ms.trace.storedWanted = wanted;
+    auto it = state.scalars.find(key);
+    if (it != state.scalars.end()) {
+      uint64_t paths = uint64_t(it->second);
+      if (paths == 0) ms.trace.storedWanted = 0;
+      ms.trace.paths = paths;
+      ms.trace.firstPath = uint64_t(pass) * paths;
+    }
+    std::unique_ptr<PhotonMap> m = buildPhotonMap(scene, ms, progress);
+    if (it == state.scalars.end()) state.scalars[key] = double(m->emitted);
+    photonSeconds += m->traceSeconds + m->buildSeconds;
+    if (!m->warning.empty() && pass == 0) st.warnings.push_back(m->warning);
+    return m;
+  };
+  bool wantGlobal = opt.visualizeGlobal || opt.gatherRays > 0;
+  std::unique_ptr<PhotonMap> caustic = trace(photon::MapKind::Caustic, opt.causticPhotons, "photons.caustic_paths_per_pass");
+  std::unique_ptr<PhotonMap> global =
+      trace(photon::MapKind::Global, wantGlobal ? opt.globalPhotons : 0, "photons.global_paths_per_pass");
+
+  // ---- kernels: pass 1's from a k-NN pilot on pass 0's maps ----
+  const bool timeDependent = opt.method == "time" && scene.hasMotion;
+  if (!hasPilot(state)) {
+    storeKernel(state, "caustic", pilotKernel(caustic.get(), scene, opt, timeDependent));
+    storeKernel(state, "global", pilotKernel(global.get(), scene, opt, timeDependent));
+    if (afterPilot) afterPilot();
+  }
+  PassKernels k = kernelsForPass(state, opt, scene, pass);
+
+  PhotonIntegratorSettings is;
+  is.timeDependent = timeDependent;
+  is.gatherRays = opt.gatherRays;
+  is.visualizeGlobal = opt.visualizeGlobal;
+  is.maxDepth = opt.maxDepth;
+  is.fixedKernels = true;
+  is.causticKernel = k.caustic;
+  is.globalKernel = k.global;
+  PhotonIntegrator integ(scene, caustic.get(), global.get(), is);
+  std::string stage = "pass " + std::to_string(pass + 1) + " render";
+  uint32_t first = uint32_t(pass) * uint32_t(opt.spp);
+  if (opt.sampler == SamplerKind::Random)
+    renderPassPixels<RandomPixelSampler>(scene, integ, opt, first, opt.spp, passTime, stage, progress, mean);
+  else
+    renderPassPixels<SobolPixelSampler>(scene, integ, opt, first, opt.spp, passTime, stage, progress, mean);
+
+  PassFigures f;
+  EstimateCounts c = integ.counts();
+  f.standardEstimates = double(c.standard);
+  f.timeEstimates = double(c.timeDependent);
+  f.causticStored = double(caustic->size());
+  f.globalStored = double(global->size());
+  f.causticEmitted = double(caustic->emitted);
+  f.globalEmitted = double(global->emitted);
+  size_t n = caustic->size() + global->size();
+  if (n > 0)
+    f.bytesPerPhoton = (caustic->bytesPerPhoton() * double(caustic->size()) +
+                        global->bytesPerPhoton() * double(global->size())) / double(n);
+  f.photonSeconds = photonSeconds;
+  f.seconds = timer.seconds();
+  return f;
+}
+
+// Adds pass state.passesDone (its pixel means and figures) into the state:
+// the one place the sums grow, for one process and for rank 0 of a job
+// alike, so both make the same float operations in the same order.
+void addPass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state, const float* mean,
+             const PassFigures& f, RenderStats& st) {
+  const int pass = state.passesDone;
+  const size_t n = size_t(scene.camera.width()) * size_t(scene.camera.height());
+  float* sum[3] = {state.layers["sum.R"].data(), state.layers["sum.G"].data(), state.layers["sum.B"].data()};
+  float* sq[3] = {state.layers["sumsq.R"].data(), state.layers["sumsq.G"].data(), state.layers["sumsq.B"].data()};
+  float* count = state.layers["spp"].data();
+  const float spp = float(opt.spp);
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const float m = mean[3 * i + size_t(c)];
+      sum[c][i] += m;
+      sq[c][i] += m * m;
+    }
+    count[i] += spp;
+  }
+  st.standardEstimates += uint64_t(f.standardEstimates);
+  st.timeEstimates += uint64_t(f.timeEstimates);
+  st.causticStored += size_t(f.causticStored);
+  st.globalStored += size_t(f.globalStored);
+  st.causticEmitted += uint64_t(f.causticEmitted);
+  st.globalEmitted += uint64_t(f.globalEmitted);
+  st.photonSeconds += f.photonSeconds;
+  if (f.causticStored + f.globalStored > 0) st.bytesPerPhoton = f.bytesPerPhoton;
+
+  const bool timeDependent = opt.method == "time" && scene.hasMotion;
+  PassKernels k = kernelsForPass(state, opt, scene, pass);
+  state.passesDone = pass + 1;
+  auto& sc = state.scalars;
+  sc["photons.emitted"] = scalarOr(state, "photons.emitted", 0) + (f.causticEmitted + f.globalEmitted);
+  sc["photons.stored"] = scalarOr(state, "photons.stored", 0) + (f.causticStored + f.globalStored);
+  sc["kernel.radius"] = double(timeDependent ? k.caustic.radius : k.caustic.spatialRadius);
+  sc["kernel.spatial_radius"] = double(k.caustic.spatialRadius);
+  sc["kernel.half_window"] = timeDependent ? double(k.caustic.halfWindow) : 0.0;
+  sc["seconds"] = scalarOr(state, "seconds", 0) + f.seconds;
 }
 
 }  // namespace
@@ -235,85 +397,9 @@ PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& o
 
 void runProgressivePass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
                         const Progress& progress, RenderStats& st) {
-  Timer timer;
-  const int pass = state.passesDone;
-  const bool accumulation = opt.method == "accumulation";
-  const bool spread = !accumulation && scene.hasMotion;
-  const float passTime = accumulation && scene.hasMotion ? accumulationPassTime(pass, opt.seed) : -1.0f;
-
-  // ---- photons: pass 0 sizes the emission with the tracer's pilot; later
-  //      passes trace the same number of paths at the next path indices ----
-  auto trace = [&](photon::MapKind kind, size_t wanted, const char* key) -> std::unique_ptr<PhotonMap> {
-    PhotonMapSettings ms;
-    ms.trace.kind = kind;
-    ms.trace.seed = opt.seed;
-    ms.trace.maxBounces = opt.maxDepth;
-    ms.trace.spreadInTime = spread;
-    ms.trace.fixedTime01 = passTime >= 0 ? passTime : 0.0f;
-    ms.trace.sampler = opt.sampler;
-    ms.trace.storedWanted = wanted;
-    auto it = state.scalars.find(key);
-    if (it != state.scalars.end()) {
-      uint64_t paths = uint64_t(it->second);
-      if (paths == 0) ms.trace.storedWanted = 0;
-      ms.trace.paths = paths;
-      ms.trace.firstPath = uint64_t(pass) * paths;
-    }
-    std::unique_ptr<PhotonMap> m = buildPhotonMap(scene, ms, progress);
-    if (it == state.scalars.end()) state.scalars[key] = double(m->emitted);
-    st.photonSeconds += m->traceSeconds + m->buildSeconds;
-    if (!m->warning.empty() && pass == 0) st.warnings.push_back(m->warning);
-    return m;
-  };
-  bool wantGlobal = opt.visualizeGlobal || opt.gatherRays > 0;
-  std::unique_ptr<PhotonMap> caustic = trace(photon::MapKind::Caustic, opt.causticPhotons, "photons.caustic_paths_per_pass");
-  std::unique_ptr<PhotonMap> global =
-      trace(photon::MapKind::Global, wantGlobal ? opt.globalPhotons : 0, "photons.global_paths_per_pass");
-
-  // ---- kernels: pass 1's from a k-NN pilot on pass 0's maps ----
-  const bool timeDependent = opt.method == "time" && scene.hasMotion;
-  if (!state.scalars.count("kernel.caustic.radius_1")) {
-    storeKernel(state, "caustic", pilotKernel(caustic.get(), scene, opt, timeDependent));
-    storeKernel(state, "global", pilotKernel(global.get(), scene, opt, timeDependent));
-  }
-  PassKernels k = kernelsForPass(state, opt, scene, pass);
-
-  PhotonIntegratorSettings is;
-  is.timeDependent = timeDependent;
-  is.gatherRays = opt.gatherRays;
-  is.visualizeGlobal = opt.visualizeGlobal;
-  is.maxDepth = opt.maxDepth;
-  is.fixedKernels = true;
-  is.causticKernel = k.caustic;
-  is.globalKernel = k.global;
-  PhotonIntegrator integ(scene, caustic.get(), global.get(), is);
-  std::string stage = "pass " + std::to_string(pass + 1) + " render";
-  uint32_t first = uint32_t(pass) * uint32_t(opt.spp);
-  if (opt.sampler == SamplerKind::Random)
-    renderPassPixels<RandomPixelSampler>(scene, integ, opt, first, opt.spp, passTime, stage, progress, state);
-  else
-    renderPassPixels<SobolPixelSampler>(scene, integ, opt, first, opt.spp, passTime, stage, progress, state);
-
-  EstimateCounts c = integ.counts();
-  st.standardEstimates += c.standard;
-  st.timeEstimates += c.timeDependent;
-  st.causticStored += caustic->size();
-  st.globalStored += global->size();
-  st.causticEmitted += caustic->emitted;
-  st.globalEmitted += global->emitted;
-  size_t n = caustic->size() + global->size();
-  if (n > 0)
-    st.bytesPerPhoton = (caustic->bytesPerPhoton() * double(caustic->size()) +
-                         global->bytesPerPhoton() * double(global->size())) / double(n);
-
-  state.passesDone = pass + 1;
-  auto& sc = state.scalars;
-  sc["photons.emitted"] = scalarOr(state, "photons.emitted", 0) + double(caustic->emitted + global->emitted);
-  sc["photons.stored"] = scalarOr(state, "photons.stored", 0) + double(n);
-  sc["kernel.radius"] = double(timeDependent ? k.caustic.radius : k.caustic.spatialRadius);
-  sc["kernel.spatial_radius"] = double(k.caustic.spatialRadius);
-  sc["kernel.half_window"] = timeDependent ? double(k.caustic.halfWindow) : 0.0;
-  sc["seconds"] = scalarOr(state, "seconds", 0) + timer.seconds();
+  std::vector<float> mean;
+  PassFigures f = computePass(scene, opt, state, state.passesDone, progress, st, mean, {});
+  addPass(scene, opt, state, mean.data(), f, st);
 }
 
 Film filmFromState(const ProgressiveState& state, int width, int height) {
@@ -343,7 +429,7 @@ Film filmFromState(const ProgressiveState& state, int width, int height) {
 }
 
 Film renderProgressive(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
-                       const Progress& progress, RenderStats& st) {
+                       const Progress& progress, RenderStats& st, dist::Comm& comm) {
   if (!isProgressiveMethod(opt.method))
     throw Error("--progressive works with the methods time, accumulation and standard, not '" + opt.method + "'");
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
@@ -352,9 +438,23 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
   // holds them all, as standard does).
   RenderOptions budget = opt;
   if (budget.method == "accumulation") budget.method = "standard";
-  checkMemoryBudget(scene, budget, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
+  std::string budgetError;
+  try {
+    checkMemoryBudget(scene, budget, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
+  } catch (const Error& e) {
+    if (!comm.distributed()) throw;
+    budgetError = e.what();
+  }
+  dist::raiseIfAnyFailed(comm, budgetError);
+  // Under mpirun rank 0 holds the state (read by --resume, written at the
+  // end); the others need where it stands and pass 0's pilot values.
+  if (comm.distributed()) {
+    state.passesDone = comm.broadcastInt(state.passesDone);
+    if (!state.empty()) sharePilot(comm, state);
+  }
   Timer timer;
   st = RenderStats{};
+  st.warnings = sceneWarnings(scene);
   const int w = scene.camera.width(), h = scene.camera.height();
   const size_t n = size_t(w) * size_t(h);
   if (state.empty()) {
@@ -362,6 +462,7 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
     state.scalars.clear();
   }
   for (const char* name : kLayers) {
+    if (!comm.root()) break;  // the sums live on rank 0 only
     std::vector<float>& l = state.layers[name];
     if (state.empty()) l.assign(n, 0.0f);
     else if (l.size() != n)
@@ -390,12 +491,57 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
                         uint64_t(scalarOr(state, "photons.emitted", 0))};
   };
   progress.at(position());
-  for (;;) {
-    if (opt.passes > 0 && state.passesDone >= opt.passes) break;
-    runProgressivePass(scene, opt, state, progress, st);
-    progress.at(position());
-    if (limit > 0 && timer.seconds() >= limit) break;
-    if (signals::stopRequested()) break;
+  if (!comm.distributed()) {
+    for (;;) {
+      if (opt.passes > 0 && state.passesDone >= opt.passes) break;
+      runProgressivePass(scene, opt, state, progress, st);
+      progress.at(position());
+      if (limit > 0 && timer.seconds() >= limit) break;
+      if (signals::stopRequested()) break;
+    }
+  } else {
+    // Rounds of N passes (docs/distributed.md): rank r runs pass first + r
+    // alone, rank 0 adds the round's passes in pass order with addPass (the
+    // same float additions as one process), then the job decides together
+    // whether to stop. Pass 0 of a new render computes the pilot values on
+    // rank 0, which sends them before rendering its pixels; the others wait
+    // for them, then run their passes.
+    const int N = comm.size(), rank = comm.rank();
+    for (bool stop = false; !stop;) {
+      const int first = state.passesDone;
+      const int inRound = opt.passes > 0 ? std::min(N, opt.passes - first) : N;
+      if (inRound <= 0) break;
+      const bool has = rank < inRound;
+      const bool needPilot = !hasPilot(state);
+      if (needPilot && !comm.root()) sharePilot(comm, state);
+      std::vector<float> mean;
+      std::vector<double> figures;
+      if (has) {
+        RenderStats own;  // warnings (rank 0's pass 0 only)
+        PassFigures f = computePass(scene, opt, state, first + rank, comm.root() ? progress : Progress{}, own, mean,
+                                    [&] { if (needPilot) sharePilot(comm, state); });
+        if (comm.root()) st.warnings.insert(st.warnings.end(), own.warnings.begin(), own.warnings.end());
+        figures = f.pack();
+      }
+      std::vector<PassFigures> roundFigures;
+      dist::combineRoundOnRoot(comm, figures, has,
+                               [&](const double* v, size_t) { roundFigures.push_back(PassFigures::unpack(v)); });
+      size_t next = 0;
+      dist::combineRoundOnRoot(comm, mean, has, [&](const float* v, size_t) {
+        addPass(scene, opt, state, v, roundFigures[next++], st);
+      });
+      state.passesDone = first + inRound;
+      if (comm.root()) progress.at(position());
+      // Stop when rank 0 says so (time limit) or any rank was asked to stop
+      // by a signal (mpirun forwards SIGTERM to every rank).
+      uint64_t want = uint64_t((comm.root() && limit > 0 && timer.seconds() >= limit) || signals::stopRequested());
+      comm.allreduceSum(&want, 1);
+      stop = want > 0;
+    }
+    if (!comm.root()) {
+      st.seconds = timer.seconds();
+      return Film();
+    }
   }
   Film film = filmFromState(state, w, h);
   st.cameraSamples = 0;

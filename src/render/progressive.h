@@ -23,6 +23,7 @@
 #include <string>
 
 #include "core/progress.h"
+#include "dist/comm.h"
 #include "estimate/fixed_kernel.h"
 #include "render/film.h"
 #include "render/progressive_state.h"
@@ -70,8 +71,16 @@ void runProgressivePass(const Scene& scene, const RenderOptions& opt, Progressiv
 // the current pass). Without either limit, kDefaultProgressiveSeconds.
 // Throws tdpm::Error for a method other than time, accumulation, standard,
 // or a state whose layers do not match the image size.
+//
+// Distributed (comm.size() = N > 1, every rank calls it alike; rank 0 holds
+// the state, the others an empty one): rounds of N passes, pass first + r on
+// rank r alone (its own photons, every pixel), the pixel means sent to rank
+// 0, which adds them in pass order: bit-identical to one process with the
+// same passes. The time limit and a signal are checked after each round (so
+// the job may run one round past the limit). Only rank 0 returns the image
+// (the others an empty Film). docs/distributed.md.
 Film renderProgressive(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
-                       const Progress& progress, RenderStats& stats);
+                       const Progress& progress, RenderStats& stats, dist::Comm& comm = dist::local());
 
 // The image of a state: sum / passes, spp, and the variance of the mean of
 // the pass means.

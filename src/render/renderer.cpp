@@ -369,6 +369,21 @@ void checkPhotonMemory(size_t caustic, size_t global, bool spaceTime4D, int maxD
               formatBytes(margin) + "); lower the photon counts");
 }
 
+std::vector<std::string> sceneWarnings(const Scene& scene) {
+  std::vector<std::string> w;
+  if (scene.lights.empty() && scene.background.isBlack())
+    w.push_back("the scene has no lights and a black background: the image will be black");
+  size_t dark = 0;
+  for (size_t i = 0; i < scene.lights.size(); ++i)
+    if (emitsNothing(scene.lights[i])) {
+      ++dark;
+      w.push_back("lights[" + std::to_string(i) + "] has zero power: it adds nothing to the image");
+    }
+  if (dark > 0 && dark == scene.lights.size() && scene.background.isBlack())
+    w.push_back("every light has zero power and the background is black: the image will be black");
+  return w;
+}
+
 const char* const* renderMethods() { return kMethods; }
 
 PixelFilter pixelFilterFor(const RenderOptions& opt) {
@@ -400,16 +415,7 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
   dist::raiseIfAnyFailed(comm, budgetError);
   Timer timer;
   st = RenderStats{};
-  if (scene.lights.empty() && scene.background.isBlack())
-    st.warnings.push_back("the scene has no lights and a black background: the image will be black");
-  size_t dark = 0;
-  for (size_t i = 0; i < scene.lights.size(); ++i)
-    if (emitsNothing(scene.lights[i])) {
-      ++dark;
-      st.warnings.push_back("lights[" + std::to_string(i) + "] has zero power: it adds nothing to the image");
-    }
-  if (dark > 0 && dark == scene.lights.size() && scene.background.isBlack())
-    st.warnings.push_back("every light has zero power and the background is black: the image will be black");
+  st.warnings = sceneWarnings(scene);
   Film film(scene.camera.width(), scene.camera.height());
   SamplingPlan plan = samplingPlanFor(opt);
   // A scene with no motion at all draws no time samples.

@@ -99,6 +99,10 @@ struct RenderStats {
   std::vector<std::string> warnings;  // for the user: empty photon maps and the like
 };
 
+// What the user should know before looking at the image: no lights and a
+// black background, lights of zero power (every render path reports them).
+std::vector<std::string> sceneWarnings(const Scene& scene);
+
 // Names of the methods the renderer accepts (for validation and --help).
 // The pixel filter the options ask for (its kind's default radius when
 // filterRadius is 0): every pixel loop (fixed budget, progressive pass,
