@@ -17,8 +17,9 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
-inline CommandResult runTdpm(const std::string& args) {
-  std::string cmd = std::string("'") + TDPM_BINARY + "' " + args + " 2>&1 < /dev/null";
+// Runs a shell command line, stdout and stderr together, stdin empty.
+inline CommandResult runShell(const std::string& commandLine) {
+  std::string cmd = commandLine + " 2>&1 < /dev/null";
   CommandResult r;
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
@@ -29,6 +30,8 @@ inline CommandResult runTdpm(const std::string& args) {
   r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
 }
+
+inline CommandResult runTdpm(const std::string& args) { return runShell(std::string("'") + TDPM_BINARY + "' " + args); }
 
 inline std::string makeTempDir() {
   char tmpl[] = "/tmp/tdpm-test-XXXXXX";

@@ -23,18 +23,9 @@ namespace {
 // mpirun of Open MPI; `timeout` turns a hang into exit status 124.
 CommandResult runMpi(int ranks, const std::string& env, const std::string& args, bool throughShell = false) {
   std::string tdpm = std::string("'") + TDPM_BINARY + "' " + args;
-  std::string cmd = "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 " + env + " timeout 120 '" +
-                    TDPM_MPIEXEC + "' --oversubscribe -np " + std::to_string(ranks) + " " +
-                    (throughShell ? "sh -c \"" + tdpm + "; echo rank-exit \\$?\"" : tdpm) + " 2>&1 < /dev/null";
-  CommandResult r;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  int status = pclose(p);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return test::runShell("OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 " + env + " timeout 120 '" +
+                        TDPM_MPIEXEC + "' --oversubscribe -np " + std::to_string(ranks) + " " +
+                        (throughShell ? "sh -c \"" + tdpm + "; echo rank-exit \\$?\"" : tdpm));
 }
 
 size_t occurrences(const std::string& text, const std::string& what) {
