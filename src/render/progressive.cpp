@@ -36,15 +36,6 @@ constexpr size_t kPilotQueries = 1024;
 
 const char* const kLayers[] = {"sum.R", "sum.G", "sum.B", "sumsq.R", "sumsq.G", "sumsq.B", "spp"};
 
-Rgb saturate(Rgb L) {
-  for (int c = 0; c < 3; ++c) {
-    float& v = L[c];
-    if (std::isnan(v)) v = 0.0f;
-    else if (std::isinf(v)) v = v > 0 ? FLT_MAX : -FLT_MAX;
-  }
-  return L;
-}
-
 float maxRadiusOf(const Scene& scene, const RenderOptions& opt) {
   if (std::isfinite(opt.estimate.maxRadius)) return opt.estimate.maxRadius;
   float diag = scene.bounds.empty() ? 1.0f : scene.extent();
@@ -172,10 +163,10 @@ void renderPassPixels(const Scene& scene, const PhotonIntegrator& integ, const R
           cam.generateRay({float(x) + p.x, float(y) + p.y}, cs.time01, o, d);
           typename PixelSampler::Stream stream = ps.stream(i);
           Rgb L = integ.radiance(o, d, cs.time01, stream, s.state);
-          if (!isFinite(L)) L = saturate(L);
+          if (!isFinite(L)) L = saturateSample(L);
           for (int c = 0; c < 3; ++c) acc[c] += double(L[c]);
         }
-        Rgb m = saturate(Rgb(float(acc[0] / spp), float(acc[1] / spp), float(acc[2] / spp)));
+        Rgb m = saturateSample(Rgb(float(acc[0] / spp), float(acc[1] / spp), float(acc[2] / spp)));
         for (int c = 0; c < 3; ++c) out[3 * idx + size_t(c)] = m[c];
       }
     integ.flush(s.state);
@@ -421,8 +412,8 @@ Film filmFromState(const ProgressiveState& state, int width, int height) {
         var[c] = float(std::min(std::max(v, 0.0), double(FLT_MAX)));
       }
     }
-    film.color[i] = saturate(mean);
-    film.varianceOfMean[i] = saturate(var);
+    film.color[i] = saturateSample(mean);
+    film.varianceOfMean[i] = saturateSample(var);
     film.sampleCount[i] = spp[i];
   }
   return film;

@@ -77,16 +77,6 @@ struct PixelAccumulator {
 static_assert(sizeof(PixelAccumulator) + sizeof(uint8_t) + sizeof(float) == kSamplerBytesPerPixel,
               "update kSamplerBytesPerPixel in render/renderer.h");
 
-// NaN -> 0, +-Inf -> +-FLT_MAX, per channel.
-Rgb saturateSample(Rgb L) {
-  for (int c = 0; c < 3; ++c) {
-    float& v = L[c];
-    if (std::isnan(v)) v = 0.0f;
-    else if (std::isinf(v)) v = v > 0 ? FLT_MAX : -FLT_MAX;
-  }
-  return L;
-}
-
 
 struct SamplingPlan {
   int batch = 16, maxSpp = 16;
