@@ -42,6 +42,19 @@ def compare(img, reference=ref, crop=None):
     return j["rel_mse"]["overall"], j["relative_mean_difference"]
 
 
+def variance_part(img):
+    """relMSE of (reference + the EXR's standard error of the mean) against the
+    reference: the noise part of a progressive image's relMSE, from its
+    variance.R/G/B layer (spread of the pass means). None without oiiotool."""
+    x = img[:-4] + ".sd.exr"
+    try:
+        subprocess.run(["oiiotool", img, "--ch", "variance.R,variance.G,variance.B", "--chnames", "R,G,B",
+                        "--powc", "0.5", ref, "--add", "-o", x], check=True, capture_output=True)
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    return compare(x)[0], compare(x, crop=crop)[0]
+
+
 def cpu_rss(name):
     u, m = open(os.path.join(out, name + ".time")).read().split()
     return float(u), int(m) / 1024.0
@@ -77,7 +90,7 @@ for series in ("time", "acc"):
         u, m = cpu_rss(n)
         cum += u
         w, c = compare(os.path.join(out, n + ".exr")), compare(os.path.join(out, n + ".exr"), crop=crop)
-        pts.append((n, passes(n), cum, m, w, c))
+        pts.append((n, passes(n), cum, m, w, c, variance_part(os.path.join(out, n + ".exr"))))
     rows[series] = pts
 
 fixed = {}
@@ -88,12 +101,14 @@ for p in glob.glob(os.path.join(out, "fixed-time-*.time")):
     fixed.setdefault(key, []).append((u, m, compare(os.path.join(out, n + ".exr")),
                                       compare(os.path.join(out, n + ".exr"), crop=crop)))
 
-print("\n| run | passes | user CPU s | peak RSS MiB | relMSE whole | relMSE caustic box | caustic box mean |")
-print("|---|---|---|---|---|---|---|")
+print("\n| run | passes | user CPU s | peak RSS MiB | relMSE whole | relMSE caustic box | caustic box mean "
+      "| noise part whole / caustic box |")
+print("|---|---|---|---|---|---|---|---|")
 for series, pts in rows.items():
     label = "time" if series == "time" else "accumulation"
-    for n, ps, t, m, w, c in pts:
-        print(f"| {label} --progressive | {ps} | {t:.1f} | {m:.1f} | {w[0]:.5f} | {c[0]:.5f} | {c[1]*100:+.2f}% |")
+    for n, ps, t, m, w, c, v in pts:
+        vs = f"{v[0]:.5f} / {v[1]:.5f}" if v else "-"
+        print(f"| {label} --progressive | {ps} | {t:.1f} | {m:.1f} | {w[0]:.5f} | {c[0]:.5f} | {c[1]*100:+.2f}% | {vs} |")
 fixed_mean = {}
 for key in sorted(fixed, key=lambda k: (len(k), k)):
     v = fixed[key]
@@ -106,7 +121,7 @@ for key in sorted(fixed, key=lambda k: (len(k), k)):
     per = ", ".join(f"{x[3][0]:.4f}" for x in v)
     means = ", ".join(f"{x[3][1]*100:+.1f}%" for x in v)
     print(f"| {key.replace('fixed-', 'fixed ')} ({k} seeds, mean) | - | {t:.1f} | {m:.1f} | {w:.5f} | {c:.5f} "
-          f"(seeds: {per}) | {means} |")
+          f"(seeds: {per}) | {means} | - |")
 
 for series, pts in rows.items():
     if len(pts) < 2:
@@ -116,6 +131,11 @@ for series, pts in rows.items():
         s2 = fit([(p[2], p[idx][0]) for p in pts[-3:]])[0]
         print(f"{series} --progressive, {region}: log-log slope of relMSE against CPU s {s:.3f} (all points), "
               f"{s2:.3f} (last three)")
+    if all(p[6] for p in pts):  # what is left when the noise is taken out: bias^2 + the reference's error
+        rest = [(p[2], p[5][0] - p[6][1]) for p in pts]
+        if all(r > 0 for _, r in rest):
+            print(f"{series} --progressive, caustic box minus its noise part: " +
+                  ", ".join(f"{r:.5f}" for _, r in rest) + f"; slope {fit(rest)[0]:.3f}, last three {fit(rest[-3:])[0]:.3f}")
     rss = [p[3] for p in pts]
     print(f"{series} --progressive: peak RSS {min(rss):.1f}-{max(rss):.1f} MiB over the runs")
 
