@@ -27,12 +27,13 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a) {
               "into the image: converges in the memory of one pass (docs/photon-map.md). Photon counts are per pass; "
               "--spp is the samples per pixel of each pass. Stops after --passes, or after the pass that reaches "
               "--time-limit (default: 30 s when neither is given); SIGINT/SIGTERM stop after the current pass and "
-              "write the passes done. Under mpirun each rank runs its own passes, one per rank per round, and the "
+              "write the passes done. This is the default when a scene is rendered with its own photon method (its render.method, "
+              "or time) and neither -m, --fixed-budget nor render.progressive says otherwise. Under mpirun each rank runs its own passes, one per rank per round, and the "
               "image equals one process's with the same passes (docs/distributed.md)")
       ->group(group);
   c->add_flag("--fixed-budget", a.fixedBudget,
-              "Render with one photon budget, not in passes, even when the scene's render block sets "
-              "\"progressive\": true (its passes and time_limit are then not used)")
+              "Render with one photon budget, not in passes: overrides the default for a scene's own photon method "
+              "and a render block's \"progressive\": true (its passes and time_limit are then not used)")
       ->excludes("--progressive")->group(group);
   c->add_option("--passes", a.passes, "--progressive: stop once this many passes are done")
       ->check(CLI::Range(1, 1 << 24))->group(group);
