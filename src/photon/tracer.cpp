@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -24,6 +25,13 @@ namespace tdpm::photon {
 namespace {
 
 constexpr uint32_t kPilotBatches = 16;
+// Photon bounces whose Sobol group seeds are hashed once per batch (deeper
+// bounces hash theirs per draw, as the eye paths do): groups up to the
+// roulette slot of vertex kSeedTableBounces.
+constexpr int kSeedTableBounces = 64;
+constexpr uint32_t kSeedTableGroups =
+    uint32_t(dims::vertexGroup(kSeedTableBounces, dims::kSlotsPerVertex));
+
 // Batches traced before they are appended to the result (see traceBatches):
 // enough work to keep every core busy, small next to a large map.
 constexpr uint64_t kBatchesPerChunk = 256;
@@ -351,6 +359,13 @@ struct Tracer {
       sobolSeed = hashCombine(sobolSeed, high);
       timeScrambleHere ^= uint32_t(mix64(high ^ 0x7173ull));
     }
+    // Every path of the batch shares the Sobol "pixel" seed, so the seeds of
+    // its groups (light, position, direction, and per bounce BSDF and
+    // roulette, up to kSeedTableBounces) are hashed once per batch, not per
+    // draw (callgrind, cube-caustic -m time 80x60: photon tracing 104.1M ->
+    // 95.5M instructions, images identical).
+    std::array<SobolStream::GroupSeeds, kSeedTableGroups> seedTable;
+    if (settings.sampler == SamplerKind::Sobol) SobolStream::fillSeedTable(sobolSeed, seedTable.data(), kSeedTableGroups);
     uint64_t rays = 0;
     for (uint32_t i = 0; i < kPathsPerBatch; ++i) {
       uint64_t g = b * kPathsPerBatch + i;
@@ -360,6 +375,8 @@ struct Tracer {
                                             : settings.fixedTime01;
       if (settings.sampler == SamplerKind::Sobol) {
         SobolStream s{sobolSeed, uint32_t(g)};
+        s.table = seedTable.data();
+        s.tableSize = kSeedTableGroups;
         rays += tracePath(time01, s, energyScale, out);
       } else {
         RandomStream s{&rng};

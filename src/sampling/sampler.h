@@ -92,10 +92,24 @@ struct SobolStream {
   struct GroupSeeds {
     uint32_t shuffle, scramble[3];
   };
-  GroupSeeds seeds(uint64_t group) const {
+  // A group's seeds depend on (pixelSeed, group) only. A caller that draws
+  // many samples with one pixelSeed (the photon tracer: one per map and
+  // batch) may hash groups [0, tableSize) once into `table`
+  // (fillSeedTable); the values are the same, only the hashing is skipped.
+  const GroupSeeds* table = nullptr;
+  uint32_t tableSize = 0;
+
+  static GroupSeeds hashSeeds(uint64_t pixelSeed, uint64_t group) {
     uint64_t h1 = mix64(pixelSeed ^ mix64(group));
     uint64_t h2 = mix64(h1);
     return {uint32_t(h1), {uint32_t(h1 >> 32), uint32_t(h2), uint32_t(h2 >> 32)}};
+  }
+  static void fillSeedTable(uint64_t pixelSeed, GroupSeeds* out, uint32_t n) {
+    for (uint32_t g = 0; g < n; ++g) out[g] = hashSeeds(pixelSeed, g);
+  }
+  GroupSeeds seeds(uint64_t group) const {
+    if (group < tableSize) return table[group];
+    return hashSeeds(pixelSeed, group);
   }
   // The shuffled index, reversed: shuffleIndex(index, seed) == reverseBits32(shuffledReversed(seed)).
   uint32_t shuffledReversed(uint32_t seed) const { return laineKarrasPermutation(reversedIndex, seed); }
