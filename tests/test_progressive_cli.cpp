@@ -145,6 +145,13 @@ TEST_CASE("progressive cli: flags that need --progressive, and methods without a
     CHECK(contains(r.output, std::string(flag).substr(0, std::string(flag).find(' '))));
     CHECK(contains(r.output, "has no effect with --progressive"));
   }
+  // Not a number is out of every range (CLI::Range let NaN through).
+  for (const char* flag : {"--progressive --alpha nan", "--progressive --time-limit nan", "--kernel-footprint nan"}) {
+    auto r = runTdpm("render '" + scene + "' " + flag + out);
+    CAPTURE(r.output);
+    CHECK(r.exitCode == 2);
+    CHECK(contains(r.output, "Value nan not in range"));
+  }
   auto help = runTdpm("render --help");
   for (const char* flag : {"--progressive", "--fixed-budget", "--passes", "--time-limit", "--alpha"})
     CHECK(contains(help.output, flag));

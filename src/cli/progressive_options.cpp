@@ -1,6 +1,8 @@
 // cli/progressive_options.cpp — see progressive_options.h.
 #include "cli/progressive_options.h"
 
+#include "cli/flag_ranges.h"
+
 #include <cstdio>
 
 #include "core/error.h"
@@ -36,15 +38,15 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a) {
               "and a render block's \"progressive\": true (its passes and time_limit are then not used)")
       ->excludes("--progressive")->group(group);
   c->add_option("--passes", a.passes, "--progressive: stop once this many passes are done")
-      ->check(CLI::Range(1, 1 << 24))->group(group);
+      ->check(rangeOf(scene::limits::kPasses))->group(group);
   c->add_option("--time-limit", a.timeLimit,
                 "--progressive: stop after the pass that reaches this many seconds (under mpirun: after the round of "
                 "passes that reaches it)")
-      ->check(CLI::PositiveNumber)->group(group);
+      ->check(rangeOf(scene::limits::kTimeLimit))->group(group);
   c->add_option("--alpha", a.alpha,
                 "--progressive: the kernel's shrink per pass, volume_{i+1} = volume_i (i + alpha)/(i + 1), in (0, 1) "
                 "(default 4/7 for time's space-time kernel, 2/3 for the spatial kernel of accumulation and standard)")
-      ->check(CLI::Range(1e-3, 0.999))->group(group);
+      ->check(rangeOf(scene::limits::kAlpha))->group(group);
 }
 
 void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath,

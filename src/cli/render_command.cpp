@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "cli/animation_command.h"
+#include "cli/flag_ranges.h"
 #include "cli/frame_pattern.h"
 #include "cli/path_names.h"
 #include "cli/progress_bar.h"
@@ -45,28 +46,6 @@ namespace {
 
 namespace limits = scene::limits;
 static_assert(limits::kTimeBins == photon::kTimeBins, "the kappa range in scene/limits.h assumes the photon time bins");
-
-std::string formatG(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
-
-CLI::Range rangeOf(limits::IntRange r) { return CLI::Range(r.lo, r.hi); }
-
-// CLI::Range prints float bounds as "0.000000": say 1.1e-19 instead.
-CLI::Validator rangeOf(limits::FloatRange r) {
-  std::string range = formatG(r.lo) + " to " + formatG(r.hi);
-  return CLI::Validator(
-      [r, range](std::string& text) -> std::string {
-        char* end = nullptr;
-        double v = std::strtod(text.c_str(), &end);
-        if (end == text.c_str() || *end != '\0') return "expected a number, got '" + text + "'";
-        if (!(v >= r.lo && v <= r.hi)) return "Value " + text + " not in range " + range;
-        return "";
-      },
-      "FLOAT in [" + range + "]");
-}
 
 std::string methodList() {
   std::string s;
@@ -368,7 +347,7 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
                 "one eye sample's share of its pixel (pixel area x shutter / spp), growing k_s up to 16x where photons "
                 "bunch; 0: pure k-NN, whose tiny kernels at a focused moving caustic give speckles (default 1, "
                 "docs/photon-map.md)")
-      ->check(CLI::Range(0.0f, 1000.0f))->group(photonGroup);
+      ->check(rangeOf(limits::kKernelFootprint))->group(photonGroup);
   c->add_option("--kernel-space", a.kernelSpace, "Space kernel: uniform, cone, epanechnikov (default uniform)")
       ->check(CLI::IsMember({"uniform", "cone", "epanechnikov"}))->group(photonGroup);
   c->add_option("--kernel-time", a.kernelTime, "Time kernel: uniform, epanechnikov (default uniform)")

@@ -68,6 +68,9 @@ constexpr FloatRange kExposure{-64.0f, 64.0f};
 constexpr FloatRange kMaxRadius{1.1e-19f, 1.8e19f};
 // Pixel filter radius in pixels (sampling/filter.h): a wider filter is a blur, not a filter.
 constexpr FloatRange kFilterRadius{0.01f, 16.0f};
+constexpr FloatRange kKernelFootprint{0.0f, 1000.0f};  // --kernel-footprint
+constexpr FloatRange kAlpha{1e-3f, 0.999f};           // --alpha (progressive kernel shrink)
+constexpr FloatRange kTimeLimit{1e-12f, 1e9f};        // --time-limit, render.time_limit (seconds)
 
 // ---- the 4D metric d^2 = |dx|^2 + kappa dt^2
 // The 4D kd-tree keys time as sqrt(kappa) t in float and resolves it to one

@@ -714,7 +714,7 @@ RenderSettings readRender(const Node& n, float shutterLength) {
     r.progressive = p.json().get<bool>();
   }
   if (n.has("passes")) r.passes = readCount(n.member("passes"), "passes", limits::kPasses);
-  if (n.has("time_limit")) r.timeLimit = readPositive(n.member("time_limit"), "time_limit");
+  if (n.has("time_limit")) r.timeLimit = readFloatInRange(n.member("time_limit"), "time_limit", limits::kTimeLimit);
   return r;
 }
 
