@@ -209,6 +209,7 @@ RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc,
   parseFilterKind(pick(a.filter, sc.filter, std::string(filterName(o.filter))), o.filter);
   o.filterRadius = pick(a.filterRadius, sc.filterRadius, o.filterRadius);
   o.maxDepth = pick(a.maxDepth, sc.maxDepth, o.maxDepth);
+  o.causticGuiding = a.causticGuiding.value_or(o.causticGuiding);
   o.causticPhotons = size_t(pick(a.photons, sc.photons, int64_t(o.causticPhotons)));
   o.globalPhotons = size_t(pick(a.globalPhotons, sc.globalPhotons, int64_t(o.globalPhotons)));
   o.frames = pick(a.frames, sc.frames, o.frames);
@@ -307,6 +308,11 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_option("--filter-radius", a.filterRadius, "Pixel filter radius in pixels (default: box 0.5, gaussian 1.5)")
       ->check(rangeOf(limits::kFilterRadius));
   c->add_option("--max-depth", a.maxDepth, "Maximum path length in vertices (default 16)")->check(rangeOf(limits::kMaxDepth));
+  c->add_option("--caustic-guiding", a.causticGuiding,
+                "pathtrace: share of the first diffuse vertex's continuation samples aimed where nearby caustic "
+                "photons left the last mirror or glass (a small photon map traced first; an unbiased mixture with "
+                "the BSDF; 0 turns it off; default 0.5; docs/sampling.md)")
+      ->check(rangeOf(limits::kCausticGuiding));
   c->add_option("--resolution", a.resolution, "Image size WxH (overrides the scene), e.g. 640x480");
   c->add_option("--exposure", a.exposure, "PNG preview exposure in stops (the EXR is unaffected)")
       ->check(rangeOf(limits::kExposure));
@@ -519,6 +525,7 @@ int runRender(const RenderArgs& a) {
                   {"tdpm/max_depth", std::to_string(opt.maxDepth)},
                   {"tdpm/render_seconds", seconds}};
   bool photonMethod = opt.method != "pathtrace";
+  if (!photonMethod) exr.metadata["tdpm/caustic_guiding"] = formatG(opt.causticGuiding);
   if (photonMethod) {
     exr.metadata["tdpm/caustic_photons"] = std::to_string(stats.causticStored);
     exr.metadata["tdpm/global_photons"] = std::to_string(stats.globalStored);

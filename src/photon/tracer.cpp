@@ -304,13 +304,14 @@ double powerTowardTargets(const Light& light, const std::vector<Target>& targets
 
 // Lights chosen by emitted power (global map) or by power sent toward the
 // specular targets (caustic map).
-LightTable makeLightTable(const Scene& scene, const std::vector<Target>* targets) {
+LightTable makeLightTable(const Scene& scene, const std::vector<Target>* targets, bool areaLightsOnly) {
   LightTable t;
   double total = 0;
   std::vector<double> w;
   for (const Light& l : scene.lights) {
     double p = targets ? powerTowardTargets(l, *targets) : std::max(0.0f, emittedPower(l, scene.bounds).average());
     p = std::max(0.0, p);
+    if (areaLightsOnly && l.isDelta()) p = 0.0;
     w.push_back(p);
     total += p;
   }
@@ -346,7 +347,7 @@ struct Tracer {
   // Traces paths [first, first + count) of batch `b` into `out`, energies
   // scaled by `energyScale` (= ts / n_e). Returns nothing: out grows.
   // Returns the number of rays cast.
-  uint64_t traceBatch(uint64_t local, double energyScale, PhotonStore& out) const {
+  uint64_t traceBatch(uint64_t local, double energyScale, PhotonStore& out, std::vector<Vec3f>* exits) const {
     uint64_t b = batchOffset + local;
     Rng rng(hashCombine(settings.seed, uint64_t(settings.kind) + 1, b), 0x9e37);
     // sobol: the path index is the sample index, the map's seed and kind the "pixel".
@@ -377,10 +378,10 @@ struct Tracer {
         SobolStream s{sobolSeed, uint32_t(g)};
         s.table = seedTable.data();
         s.tableSize = kSeedTableGroups;
-        rays += tracePath(time01, s, energyScale, out);
+        rays += tracePath(time01, s, energyScale, out, exits);
       } else {
         RandomStream s{&rng};
-        rays += tracePath(time01, s, energyScale, out);
+        rays += tracePath(time01, s, energyScale, out, exits);
       }
     }
     return rays;
@@ -388,8 +389,10 @@ struct Tracer {
 
   // Draws follow sampling/sampler.h's photon groups; RandomStream ignores
   // the group and draws in call order, which is the old PCG32 order.
+  // exits (caustic maps, optional): receives each stored photon's last
+  // specular vertex, in store order.
   template <class Stream>
-  uint64_t tracePath(float time01, Stream& rng, double energyScale, PhotonStore& out) const {
+  uint64_t tracePath(float time01, Stream& rng, double energyScale, PhotonStore& out, std::vector<Vec3f>* exits) const {
     uint64_t rays = 0;
     uint32_t li = lights.pick(rng.get1D(dims::kPhotonLight));
     const Light& light = scene.lights[li];
@@ -407,6 +410,7 @@ struct Tracer {
     // starting on it would hit it at distance zero.
     Vec3f origin = scene.spawnOrigin(ray.origin, ray.direction, ray.direction), dir = ray.direction;
     bool allSpecular = true;  // every bounce so far was a delta reflection/refraction
+    Vec3f lastSpecular = origin;
     for (int bounce = 0; bounce <= settings.maxBounces; ++bounce) {
       Hit hit;
       ++rays;
@@ -417,7 +421,10 @@ struct Tracer {
         bool store = settings.kind == MapKind::Global || (bounce > 0 && allSpecular);
         // The side it arrived on keeps it out of estimates on the other side
         // of the same object (photon/surface_tag.h).
-        if (store) out.add(hit.p, power * float(energyScale), -dir, time, surfaceTag(hit.object, dot(hit.n, dir) > 0.0f));
+        if (store) {
+          out.add(hit.p, power * float(energyScale), -dir, time, surfaceTag(hit.object, dot(hit.n, dir) > 0.0f));
+          if (exits) exits->push_back(lastSpecular);
+        }
         if (settings.kind == MapKind::Caustic) return rays;  // L S+ D ends here
       }
       ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
@@ -426,6 +433,7 @@ struct Tracer {
       if (!bsdfSample(ctx, {ub.x, ub.y}, ub.z, Transport::Importance, bs)) return rays;
       if (settings.kind == MapKind::Caustic && !bs.delta) return rays;
       allSpecular = allSpecular && bs.delta;
+      if (bs.delta) lastSpecular = hit.p;
       // Russian roulette by the scattering's throughput: surviving photons
       // keep (on average) their power instead of dimming.
       float survive = std::min(1.0f, bs.weight.maxComponent());
@@ -442,7 +450,8 @@ struct Tracer {
   // for the expected count, so memory peaks near the final store's 20 bytes
   // per photon instead of holding every batch buffer and the result at once.
   PhotonStore traceBatches(uint64_t firstBatch, uint64_t endBatch, double energyScale, const Progress& progress,
-                           const char* stage, size_t expected, uint64_t* raysOut = nullptr) const {
+                           const char* stage, size_t expected, uint64_t* raysOut = nullptr,
+                           std::vector<Vec3f>* exitsOut = nullptr) const {
     PhotonStore all(t0, t1);
     all.reserve(expected);
     std::atomic<uint64_t> rays{0};
@@ -452,16 +461,19 @@ struct Tracer {
     const size_t paths = size_t(batches) * kPathsPerBatch;
     progress(stage, 0, paths);
     std::vector<PhotonStore> parts;
+    std::vector<std::vector<Vec3f>> partExits;
     for (uint64_t first = firstBatch; first < endBatch; first += kBatchesPerChunk) {
       size_t count = size_t(std::min<uint64_t>(kBatchesPerChunk, endBatch - first));
       parts.assign(count, PhotonStore(t0, t1));
+      partExits.assign(exitsOut ? count : 0, {});
       tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t b = r.begin(); b != r.end(); ++b) {
-          rays += traceBatch(first + b, energyScale, parts[b]);
+          rays += traceBatch(first + b, energyScale, parts[b], exitsOut ? &partExits[b] : nullptr);
           progress(stage, (done.fetch_add(1) + 1) * kPathsPerBatch, paths);
         }
       });
       all.appendBatches(parts);
+      for (const std::vector<Vec3f>& e : partExits) exitsOut->insert(exitsOut->end(), e.begin(), e.end());
     }
     if (raysOut) *raysOut = rays.load();
     return all;
@@ -525,7 +537,9 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   std::vector<Target> targets;
   if (settings.kind == MapKind::Caustic) targets = specularTargets(scene, u0, u1);
   Tracer tracer{scene, settings, targets,
-                makeLightTable(scene, settings.kind == MapKind::Caustic && settings.projection ? &targets : nullptr), t0,
+                makeLightTable(scene, settings.kind == MapKind::Caustic && settings.projection ? &targets : nullptr,
+                               settings.areaLightsOnly),
+                t0,
                 t1, ts,
                 uint32_t(mix64(settings.seed ^ 0x7173ull)), u0, u1};
   if (settings.storedWanted == 0 || tracer.lights.empty()) return result;
@@ -540,7 +554,8 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
     result.emitted = settings.paths;
     double energyScale = double(tracer.ts) / double(result.emitted);
     size_t expected = settings.storedWanted + size_t(4.0 * std::sqrt(double(settings.storedWanted))) + 1024;
-    result.store = tracer.traceBatches(0, batches, energyScale, progress, stage, expected, &result.rays);
+    result.store = tracer.traceBatches(0, batches, energyScale, progress, stage, expected, &result.rays,
+                                       settings.keepExitPoints ? &result.exitPoints : nullptr);
     result.store.shrinkToFit();
     result.seconds = timer.seconds();
     return result;
@@ -603,7 +618,9 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   uint64_t lo = 0, hi = 0;
   dist::blockRange(batches, comm.rank(), comm.size(), lo, hi);
   if (comm.distributed()) expected = size_t(double(expected) * double(hi - lo) / double(batches)) + 1024;
-  result.store = tracer.traceBatches(lo, hi, energyScale, progress, stage, expected, &result.rays);
+  TDPM_ASSERT(!settings.keepExitPoints || !comm.distributed(), "exit points are kept by one process's maps only");
+  result.store = tracer.traceBatches(lo, hi, energyScale, progress, stage, expected, &result.rays,
+                                     settings.keepExitPoints ? &result.exitPoints : nullptr);
   comm.allreduceSum(&result.rays, 1);
   result.rays += pilotRays;
   result.store.shrinkToFit();

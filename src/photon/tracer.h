@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "core/progress.h"
 #include "dist/comm.h"
@@ -58,6 +59,12 @@ struct TraceSettings {
   // kPathsPerBatch too): pass i continues the sequences of the passes before.
   uint64_t firstPath = 0;
   uint64_t paths = 0;
+  // The path tracer's caustic guide (render/caustic_guide.h): emit from area
+  // lights only (point, spot and sun caustics are not paths a path tracer
+  // can find), and keep each stored photon's last specular vertex in
+  // TraceResult::exitPoints (one process only, not under MPI).
+  bool areaLightsOnly = false;
+  bool keepExitPoints = false;
 };
 
 // Paths per batch: the unit of emission counts and of TraceSettings::firstPath.
@@ -70,6 +77,7 @@ struct TraceResult {
   double seconds = 0;
   std::string warning;   // set when the map is empty or smaller than wanted
   double storedPerPath = 0;  // the pilot's rate (or the one given), 0 when nothing is stored
+  std::vector<Vec3f> exitPoints;  // keepExitPoints: photon i's last specular vertex, in store order
 };
 
 // Shutter interval the photon store quantises time over. A zero-length

@@ -9,7 +9,7 @@ namespace tdpm {
 
 template <class Stream>
 Rgb directLight(const Scene& scene, const Hit& hit, const ShadingContext& ctx, float time01, Stream& sampler,
-                int vertex, int bsdfSamples) {
+                int vertex, int bsdfSamples, const GuideCones* guide) {
   Rgb sum(0.0f);
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     const Light& light = scene.lights[i];
@@ -26,14 +26,21 @@ Rgb directLight(const Scene& scene, const Hit& hit, const ShadingContext& ctx, f
     if (light.isDelta()) {
       sum += f * ls.li * cosTheta;
     } else {
-      float w = bsdfSamples > 0 ? 1.0f - emissionWeight(bsdfPdf(ctx, ls.wi), ls.pdf, bsdfSamples) : 1.0f;
+      float w = 1.0f;
+      if (bsdfSamples > 0) {
+        float pb = bsdfPdf(ctx, ls.wi);
+        if (guide) pb = guide->pdf(pb, ls.wi);
+        w = 1.0f - emissionWeight(pb, ls.pdf, bsdfSamples);
+      }
       sum += f * ls.li * (cosTheta * w / ls.pdf);
     }
   }
   return sum;
 }
 
-template Rgb directLight<RandomStream>(const Scene&, const Hit&, const ShadingContext&, float, RandomStream&, int, int);
-template Rgb directLight<SobolStream>(const Scene&, const Hit&, const ShadingContext&, float, SobolStream&, int, int);
+template Rgb directLight<RandomStream>(const Scene&, const Hit&, const ShadingContext&, float, RandomStream&, int, int,
+                                      const GuideCones*);
+template Rgb directLight<SobolStream>(const Scene&, const Hit&, const ShadingContext&, float, SobolStream&, int, int,
+                                     const GuideCones*);
 
 }  // namespace tdpm

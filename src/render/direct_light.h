@@ -8,16 +8,19 @@
 #include "core/rng.h"
 #include "sampling/sampler.h"
 #include "scene/bsdf.h"
+#include "render/guided_sampling.h"
 #include "scene/scene.h"
 
 namespace tdpm {
 
 // `vertex` is the path vertex (sampling/sampler.h dimension order): light
 // i's point is drawn from group vertexGroup(vertex, kLightPosition, i).
-// Defined for RandomStream and SobolStream.
+// Defined for RandomStream and SobolStream. `guide`: when the caller's
+// BSDF rays come from the guided mixture (render/guided_sampling.h), its
+// density replaces the BSDF's in the MIS weight.
 template <class Stream>
 Rgb directLight(const Scene& scene, const Hit& hit, const ShadingContext& ctx, float time01, Stream& sampler,
-                int vertex, int bsdfSamples);
+                int vertex, int bsdfSamples, const GuideCones* guide = nullptr);
 
 // MIS weight of a BSDF-sampled ray (one of `bsdfSamples`, density
 // bsdfPdf) that hit an area light which light sampling would have chosen

@@ -7,6 +7,7 @@
 
 #include "sampling/warp.h"
 #include "render/direct_light.h"
+#include "render/guided_sampling.h"
 #include "scene/bsdf.h"
 
 namespace tdpm {
@@ -16,14 +17,22 @@ constexpr int kRouletteStartDepth = 3;
 }
 
 template <class Stream>
-Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler) const {
+Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts) const {
   Rgb L(0.0f), beta(1.0f);
   // Product of eta^2 over the refractions so far: the radiance scaling
   // 1/eta^2 a refraction puts into beta is undone for Russian roulette,
   // which should judge the path's energy, not its being inside glass
   // (inside the ball beta is 1/2.25 of what it will be again outside).
   float etaScale = 1.0f;
+  // Roulette also undoes the guide: a guided direction's weight f cos / p
+  // is small because p is large (the guide is sure of it), not because the
+  // path carries little, and judging by it killed ~99.98% of guided paths
+  // on their way through the glass (their survivors came back as
+  // fireflies). guideScale = p_mix / p_bsdf over the guided vertices, so
+  // roulette sees the weight plain BSDF sampling would have given.
+  float guideScale = 1.0f;
   bool lastDelta = true;  // the camera ray counts as "specular": no MIS on a direct hit
+  bool firstDiffuse = true;  // no non-delta vertex yet: where seen caustics are guided
   float lastPdf = 0.0f;
   Vec3f lastP = origin;
   // maxDepth_ vertices scatter (next-event estimation and a BSDF sample);
@@ -52,13 +61,25 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler) co
     const Material& mat = scene_.materials[scene_.objects[hit.object].material];
     ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
 
+    // Guide cones at the first diffuse vertex (a caustic seen directly or
+    // in a mirror); deeper vertices' caustics are blurred by a diffuse
+    // bounce and carry little of the variance.
+    GuideCones cones;
+    if (guide_ && firstDiffuse && !mat.isDeltaOnly()) guide_->conesAt(mat, hit.p, ctx.frame.n, ts.guideQuery, cones);
+    if (!mat.isDeltaOnly()) firstDiffuse = false;
+
     // ---- next-event estimation ----
-    if (!mat.isDeltaOnly()) L += beta * directLight(scene_, hit, ctx, time01, sampler, depth, /*bsdfSamples=*/1);
+    if (!mat.isDeltaOnly())
+      L += beta * directLight(scene_, hit, ctx, time01, sampler, depth, /*bsdfSamples=*/1, &cones);
 
     // ---- continue the path ----
     BsdfSample bs;
     Vec3f ub = sampler.get3D(dims::vertexGroup(depth, dims::kBsdf));
-    if (!bsdfSample(ctx, {ub.x, ub.y}, ub.z, Transport::Radiance, bs)) break;
+    if (!guidedBsdfSample(ctx, cones, {ub.x, ub.y}, ub.z, bs)) break;
+    if (cones.active()) {
+      float pb = bsdfPdf(ctx, bs.wi);
+      if (pb > 0.0f) guideScale *= bs.pdf / pb;
+    }
     beta *= bs.weight;
     if (beta.isBlack() || !isFinite(beta)) break;
     if (bs.delta && mat.type == Material::Type::Dielectric && (dot(bs.wi, hit.n) < 0) != (dot(-dir, hit.n) < 0)) {
@@ -73,7 +94,7 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler) co
 
     // Roulette only a path whose weight has fallen below 1 (a path at full
     // weight gains nothing from being killed 5% of the time).
-    float rr = beta.maxComponent() * etaScale;
+    float rr = beta.maxComponent() * etaScale * guideScale;
     if (depth + 1 >= kRouletteStartDepth && rr < 1.0f) {
       float survive = rr;
       if (sampler.get1D(dims::vertexGroup(depth, dims::kRoulette)) >= survive) break;
@@ -83,7 +104,7 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler) co
   return L;
 }
 
-template Rgb PathTracer::trace<RandomStream>(Vec3f, Vec3f, float, RandomStream&) const;
-template Rgb PathTracer::trace<SobolStream>(Vec3f, Vec3f, float, SobolStream&) const;
+template Rgb PathTracer::trace<RandomStream>(Vec3f, Vec3f, float, RandomStream&, ThreadState&) const;
+template Rgb PathTracer::trace<SobolStream>(Vec3f, Vec3f, float, SobolStream&, ThreadState&) const;
 
 }  // namespace tdpm

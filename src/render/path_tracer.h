@@ -4,9 +4,13 @@
 // heuristic), Russian roulette, and one time per path: the unbiased
 // reference every photon-mapping method is judged against. Caustics from
 // delta lights (point, spot, sun) through specular chains cannot be found
-// by it: reference scenes for caustics use area lights.
+// by it: reference scenes for caustics use area lights. Caustics from area
+// lights are found far more often when the first diffuse vertex aims part
+// of its samples where caustic photons came from (render/caustic_guide.h).
 #pragma once
 #include "core/rng.h"
+#include "photon/kdtree.h"
+#include "render/caustic_guide.h"
 #include "sampling/sampler.h"
 #include "scene/scene.h"
 
@@ -14,29 +18,37 @@ namespace tdpm {
 
 class PathTracer {
  public:
-  PathTracer(const Scene& scene, int maxDepth) : scene_(scene), maxDepth_(maxDepth) {}
+  // guide: null or disabled for plain BSDF sampling; must outlive the tracer.
+  PathTracer(const Scene& scene, int maxDepth, const CausticGuide* guide = nullptr)
+      : scene_(scene), maxDepth_(maxDepth), guide_(guide && guide->enabled() ? guide : nullptr) {}
 
+  // Per-thread scratch: the guide's k-NN buffer.
+  struct ThreadState {
+    photon::KnnQuery guideQuery{CausticGuide::kNeighbours};
+  };
   // Radiance arriving at `origin` from direction `dir`, at time time01.
-  struct ThreadState {};
   // Stream: RandomStream or SobolStream (sampling/sampler.h); draws follow
   // its dimension order, vertex = depth.
   template <class Stream>
-  Rgb radiance(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState&) const {
-    return trace(origin, dir, time01, sampler);
+  Rgb radiance(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts) const {
+    return trace(origin, dir, time01, sampler, ts);
   }
-  Rgb radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng, ThreadState&) const { return radiance(origin, dir, time01, rng); }
-  Rgb radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const {
+  Rgb radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng, ThreadState& ts) const {
     RandomStream s{&rng};
-    return trace(origin, dir, time01, s);
+    return trace(origin, dir, time01, s, ts);
+  }
+  Rgb radiance(Vec3f origin, Vec3f dir, float time01, Rng& rng) const {
+    ThreadState ts;
+    return radiance(origin, dir, time01, rng, ts);
   }
   template <class Stream>
-  Rgb trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler) const;
+  Rgb trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts) const;
   void flush(ThreadState&) const {}
 
  private:
-
   const Scene& scene_;
   int maxDepth_;
+  const CausticGuide* guide_;
 };
 
 }  // namespace tdpm

@@ -263,6 +263,23 @@ Maps tracePhotonMaps(const Scene& scene, const RenderOptions& opt, size_t causti
   return maps;
 }
 
+constexpr size_t kMinGuidePhotons = 20000, kMaxGuidePhotons = 200000;
+
+// The path tracer's caustic guide (render/caustic_guide.h): traced with the
+// render's seed and sampler, so an image depends on nothing else.
+CausticGuide buildCausticGuide(const Scene& scene, const RenderOptions& opt, const Progress& progress) {
+  CausticGuideSettings s;
+  s.fraction = opt.causticGuiding;
+  // Automatic: one guide photon per 100 camera samples, within [20k, 200k]
+  // (tracing them costs ~1-3% of the eye pass: 200k take ~1 s here).
+  double samples = double(scene.camera.width()) * double(scene.camera.height()) * double(opt.spp);
+  s.photons = opt.guidePhotons > 0 ? opt.guidePhotons
+                                   : size_t(std::clamp(samples / 100.0, double(kMinGuidePhotons), double(kMaxGuidePhotons)));
+  s.seed = opt.seed;
+  s.sampler = opt.sampler;
+  return CausticGuide::build(scene, s, progress);
+}
+
 PhotonIntegratorSettings integratorSettings(const Scene& scene, const RenderOptions& opt, bool timeDependent) {
   PhotonIntegratorSettings s;
   s.timeDependent = timeDependent;
@@ -413,7 +430,8 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
   plan.comm = &comm;
 
   if (opt.method == "pathtrace") {
-    PathTracer pt(scene, opt.maxDepth);
+    CausticGuide guide = buildCausticGuide(scene, opt, progress);
+    PathTracer pt(scene, opt.maxDepth, &guide);
     renderPixels(scene, pt, plan, "render", progress, film);
   } else if (opt.method == "accumulation") {
     // N in-between frames at equally spaced times, each with its own maps
@@ -487,7 +505,8 @@ Film renderFrame(const Scene& scene, const RenderOptions& opt, const FrameInput&
   plan.time01Lo = scene.shutter.normalized(frame.shutter.open);
   plan.time01Hi = scene.shutter.normalized(frame.shutter.close);
   if (opt.method == "pathtrace") {
-    PathTracer pt(scene, opt.maxDepth);
+    CausticGuide guide = buildCausticGuide(scene, opt, progress);
+    PathTracer pt(scene, opt.maxDepth, &guide);
     renderPixels(scene, pt, plan, "render", progress, film);
   } else {
     PhotonIntegratorSettings s = integratorSettings(scene, opt, opt.method == "time" && scene.hasMotion);

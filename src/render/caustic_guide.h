@@ -1,0 +1,75 @@
+// render/caustic_guide.h — where the path tracer should aim to find
+// caustics from area lights, learned from a small caustic photon map.
+//
+// Why: a caustic path (eye -> diffuse -> glass/mirror ... -> area light) is
+// found by the path tracer only when a BSDF sample at the diffuse vertex
+// happens to leave along the specular chain that ends on the light;
+// next-event estimation cannot cross a delta interface. On
+// scenes/cube-caustic.json such paths carry ~90% of the per-sample variance
+// (/work/notes/sampling2.md). Seen from the floor through the ball, the
+// 0.15 m lamp is an image ~1 degree across: aiming at the ball does not help
+// (it fills a 36-degree cone over the box), and aiming along stored photon
+// directions does not either (their 16-bit encoding errs by ~1.2 degrees).
+// What does: each guide photon keeps the point where it left the last
+// specular surface, so from a vertex x the direction toward that point is
+// the direction a path must leave x in to retrace the photon's chain back
+// to the light, corrected for x not being where the photon landed (Jensen
+// 1995, "Importance driven path tracing using the photon map", with exit
+// points instead of directions).
+//
+// At the first diffuse-like vertex of an eye path, the k nearest guide
+// photons within a radius give k cones around those directions (half-angle
+// from their own spread), mixed with BSDF sampling by
+// render/guided_sampling.h, which keeps the estimate unbiased whatever the
+// guide holds. The guide is a fixed function of the scene and the seed,
+// built before any pixel by every process alike, so images stay identical
+// across threads and MPI ranks.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/progress.h"
+#include "photon/kdtree.h"
+#include "photon/store.h"
+#include "render/guided_sampling.h"
+#include "sampling/sampler.h"
+#include "scene/scene.h"
+
+namespace tdpm {
+
+struct CausticGuideSettings {
+  float fraction = 0.5f;    // c of the mixture; 0: no guide
+  size_t photons = 50000;   // stored caustic photons wanted
+  uint64_t seed = 1;
+  SamplerKind sampler = SamplerKind::Sobol;
+};
+
+class CausticGuide {
+ public:
+  static constexpr int kNeighbours = 8;
+
+  CausticGuide() = default;  // disabled
+  // Traces the guide's photons (nothing when c = 0, or the scene has no
+  // specular object or no area light).
+  static CausticGuide build(const Scene& scene, const CausticGuideSettings& settings, const Progress& progress);
+
+  bool enabled() const { return fraction_ > 0.0f; }
+  size_t photonCount() const { return exits_.size(); }
+  float radius() const { return std::sqrt(radius2_); }
+  // Cones for a vertex at p on material m with shading normal n (on the
+  // side the path arrived from); none for other than diffuse and plastic
+  // materials, or with fewer than 3 guide photons within radius().
+  // q: the calling thread's query buffer (capacity >= kNeighbours).
+  void conesAt(const Material& m, Vec3f p, Vec3f n, photon::KnnQuery& q, GuideCones& out) const;
+
+ private:
+  float fraction_ = 0.0f;
+  float radius2_ = 0.0f;
+  std::unique_ptr<photon::PhotonStore> store_;  // positions, in the tree's order
+  photon::KdTree tree_;
+  std::vector<Vec3f> exits_;  // photon i's last specular vertex, same order
+  std::vector<float> halfAngle_;  // photon i's cone half-angle (radians)
+};
+
+}  // namespace tdpm
