@@ -71,7 +71,10 @@ std::vector<float> pilotNoise(const Scene& scene, const RenderOptions& opt, cons
   // those its neighbours missed (a motion-blurred highlight runs across
   // pixels): first the 3x3 neighbourhood's mean variance over its mean
   // value, then the largest of that within kDilation pixels.
-  std::vector<float> local(n, 0.0f), noise(n, 0.0f);
+  // (Transients are freed as soon as they are used: at most 12 bytes a
+  // pixel at once besides the progressive state, within what the memory
+  // pre-flight charges for a render's sampler, render/memory_budget.h.)
+  std::vector<float> local(n, 0.0f);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       double v = 0, m = 0;
@@ -87,6 +90,8 @@ std::vector<float> pilotNoise(const Scene& scene, const RenderOptions& opt, cons
         }
       local[size_t(y) * size_t(w) + size_t(x)] = float(std::sqrt(v / k) / (m / k + floor));
     }
+  std::vector<float>().swap(mean);
+  std::vector<float>().swap(var);
   // Separable max filter: rows, then columns.
   std::vector<float> rows(n, 0.0f);
   for (int y = 0; y < h; ++y)
@@ -96,6 +101,8 @@ std::vector<float> pilotNoise(const Scene& scene, const RenderOptions& opt, cons
         best = std::max(best, local[size_t(y) * size_t(w) + size_t(xx)]);
       rows[size_t(y) * size_t(w) + size_t(x)] = best;
     }
+  std::vector<float>().swap(local);
+  std::vector<float> noise(n, 0.0f);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       float best = 0.0f;
