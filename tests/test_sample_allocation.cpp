@@ -247,30 +247,34 @@ TEST_CASE("sample allocation: adaptive passes on the moving plane converge to th
   CHECK(got / want == doctest::Approx(1.0).epsilon(0.03));
 }
 
-TEST_CASE("sample allocation: N passes continued for N more equal 2N, for 1 and 2 threads") {
+TEST_CASE("sample allocation: N passes continued for N more equal 2N, for 1 and 2 threads, both samplers") {
   auto s = Scene::build(glassHighlight(24, 16));
-  RenderOptions o = glassOptions(0.5f);
-  o.passes = 4;
-  ProgressiveState whole;
-  RenderStats st;
-  Film f = renderProgressive(*s, o, whole, Progress{}, st);
-  CHECK(st.maxSpp > 4 * o.spp);  // the map is in use
-  ProgressiveState half;
-  o.passes = 2;
-  renderProgressive(*s, o, half, Progress{}, st);
-  ProgressiveState copy = half;  // as if written and read back: the map is recomputed
-  o.passes = 4;
-  renderProgressive(*s, o, copy, Progress{}, st);
-  CHECK(sameLayers(whole, copy));
-  {
-    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-    ProgressiveState serial;
-    renderProgressive(*s, o, serial, Progress{}, st);
-    CHECK(sameLayers(whole, serial));
+  for (SamplerKind kind : {SamplerKind::Sobol, SamplerKind::Random}) {
+    CAPTURE(samplerName(kind));
+    RenderOptions o = glassOptions(0.5f);
+    o.sampler = kind;
+    o.passes = 4;
+    ProgressiveState whole;
+    RenderStats st;
+    renderProgressive(*s, o, whole, Progress{}, st);
+    CHECK(st.maxSpp > 4 * o.spp);  // the map is in use
+    ProgressiveState half;
+    o.passes = 2;
+    renderProgressive(*s, o, half, Progress{}, st);
+    ProgressiveState copy = half;  // as if written and read back: the map is recomputed
+    o.passes = 4;
+    renderProgressive(*s, o, copy, Progress{}, st);
+    CHECK(sameLayers(whole, copy));
+    {
+      tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+      ProgressiveState serial;
+      renderProgressive(*s, o, serial, Progress{}, st);
+      CHECK(sameLayers(whole, serial));
+    }
+    // The map changes the image (the check can fail).
+    ProgressiveState plain;
+    o.passExtraSamples = 0;
+    renderProgressive(*s, o, plain, Progress{}, st);
+    CHECK_FALSE(sameLayers(whole, plain));
   }
-  // The map changes the image (the check can fail).
-  ProgressiveState plain;
-  o.passExtraSamples = 0;
-  renderProgressive(*s, o, plain, Progress{}, st);
-  CHECK_FALSE(sameLayers(whole, plain));
 }
