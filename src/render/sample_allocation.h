@@ -38,7 +38,7 @@ std::vector<float> pilotNoise(const Scene& scene, const RenderOptions& opt, cons
                               dist::Comm& comm = dist::local());
 constexpr double kNoiseFloorFraction = 0.5;
 // ... and the largest such value within this many pixels (a square): a
-// highlight that 16 pilot samples meet in one pixel of a streak stands for
+// highlight that the pilot samples meet in one pixel of a streak stands for
 // the streak's pixels that they missed.
 constexpr int kDilation = 3;
 
