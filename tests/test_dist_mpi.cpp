@@ -6,6 +6,8 @@
 // registers a skipped test otherwise). Small images and few photons.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+
 #include <cstring>
 #include <map>
 #include <string>
@@ -93,6 +95,12 @@ void checkSameProgressive(int ranks, int passes) {
   image::ExrFile a = image::readExr(dir + "/one.exr"), b = image::readExr(dir + "/many.exr");
   CHECK(b.metadata["tdpm/progressive/passes"] == std::to_string(passes));
   CHECK(a.extra.size() >= 7);  // the state's layers ride in the EXR
+  // The CLI's default per-pixel eye sample counts are on (every rank makes
+  // the same map, render/sample_allocation.h): the counts differ by pixel.
+  const image::Channel* spp = a.findChannel("spp");
+  REQUIRE(spp != nullptr);
+  CHECK(*std::max_element(spp->values.begin(), spp->values.end()) >
+        *std::min_element(spp->values.begin(), spp->values.end()));
   CHECK_MESSAGE(sameBits(a, b), ranks << " ranks, " << passes << " passes differ from one process");
   CHECK(progressiveAttributes(a) == progressiveAttributes(b));
   CommandResult fewer = test::runTdpm(progressiveArgs() + "--passes " + std::to_string(passes - 1) + " -t 2 -o " +

@@ -123,7 +123,8 @@ TEST_CASE("progressive cli: flags that need --progressive, and methods without a
   std::string scene = writeScene(dir, "s.json", "16, 12", 2000, 1000);
   std::string out = " -o '" + dir + "/o.exr'";
   // A method chosen with -m (or --fixed-budget) keeps one budget: pass flags are errors.
-  for (const char* flag : {"--passes 3", "--time-limit 1", "--alpha 0.5", "--fixed-budget --passes 3"}) {
+  for (const char* flag : {"--passes 3", "--time-limit 1", "--alpha 0.5", "--fixed-budget --passes 3",
+                           "--extra-samples 0.2", "--extra-cap 4"}) {
     auto r = runTdpm("render '" + scene + "' -m time " + flag + out);
     CAPTURE(r.output);
     CHECK(r.exitCode == 1);
@@ -144,16 +145,19 @@ TEST_CASE("progressive cli: flags that need --progressive, and methods without a
     CHECK(r.exitCode == 1);
     CHECK(contains(r.output, std::string(flag).substr(0, std::string(flag).find(' '))));
     CHECK(contains(r.output, "has no effect with --progressive"));
+    if (std::string(flag) == "--max-spp 8") CHECK(contains(r.output, "--extra-samples"));
   }
   // Not a number is out of every range (CLI::Range let NaN through).
-  for (const char* flag : {"--progressive --alpha nan", "--progressive --time-limit nan", "--kernel-footprint nan"}) {
+  for (const char* flag : {"--progressive --alpha nan", "--progressive --time-limit nan", "--kernel-footprint nan",
+                           "--progressive --extra-samples nan", "--progressive --extra-samples -1"}) {
     auto r = runTdpm("render '" + scene + "' " + flag + out);
     CAPTURE(r.output);
     CHECK(r.exitCode == 2);
-    CHECK(contains(r.output, "Value nan not in range"));
+    CHECK((contains(r.output, "Value nan not in range") || contains(r.output, "Value -1 not in range")));
   }
   auto help = runTdpm("render --help");
-  for (const char* flag : {"--progressive", "--fixed-budget", "--passes", "--time-limit", "--alpha"})
+  for (const char* flag : {"--progressive", "--fixed-budget", "--passes", "--time-limit", "--alpha", "--extra-samples",
+                           "--extra-cap"})
     CHECK(contains(help.output, flag));
   std::string keyed = writeScene(dir, "k.json", "16, 12", 2000, 1000, ", \"passes\": 2");
   auto k = runTdpm("render '" + keyed + "' -m time" + out);

@@ -5,6 +5,8 @@
 // --progressive (exit 1, nothing written).
 #include <doctest/doctest.h>
 
+#include <algorithm>
+
 #include <cstring>
 #include <string>
 
@@ -192,5 +194,16 @@ TEST_CASE("resume: N passes, then N more resumed from the EXR, equal 2N passes i
   CHECK(b.metadata["tdpm/progressive/passes"] == "4");
   // ... and the comparison can fail: 2 passes are another image.
   CHECK(std::memcmp(a.color.pixels.data(), two.color.pixels.data(), a.color.pixels.size() * sizeof(Rgb)) != 0);
+  // The default per-pixel eye sample counts (render/sample_allocation.h) are
+  // recomputed on resume: the spp layers agree too, and vary by pixel.
+  const image::Channel *sa = a.findChannel("spp"), *sb = b.findChannel("spp");
+  REQUIRE((sa && sb));
+  CHECK(sa->values == sb->values);
+  CHECK(*std::max_element(sa->values.begin(), sa->values.end()) > 4.0f);
+  // Resuming without them is another render, named as such.
+  test::CommandResult off = test::runTdpm(base + "--extra-samples 0 --passes 6 --resume " + dir + "/full.exr -o " + dir +
+                                          "/off.exr");
+  CHECK(off.exitCode == 1);
+  CHECK(off.output.find("extra_samples: 0.5 (cap 32) in") != std::string::npos);
   std::system(("rm -rf '" + dir + "'").c_str());
 }

@@ -47,6 +47,18 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a) {
                 "--progressive: the kernel's shrink per pass, volume_{i+1} = volume_i (i + alpha)/(i + 1), in (0, 1) "
                 "(default 4/7 for time's space-time kernel, 2/3 for the spatial kernel of accumulation and standard)")
       ->check(rangeOf(scene::limits::kAlpha))->group(group);
+  c->add_option("--extra-samples", a.extraSamples,
+                "--progressive: extra eye samples per pass, as a fraction of spp x pixels, given to the pixels whose "
+                "eye paths an eye-only pilot (32 discarded samples per pixel, before pass 0) finds noisy: a "
+                "motion-blurred highlight seen in glass, a moving shadow. Each pixel takes the same count in every "
+                "pass, between --spp and --extra-cap x --spp, so the image stays unbiased and a resumed or mpirun "
+                "render equals one run; the EXR's spp layer holds the real counts. 0: every pixel takes --spp "
+                "(default " + formatG(kDefaultExtraSamples) + ")")
+      ->check(rangeOf(kExtraSamplesRange))->group(group);
+  c->add_option("--extra-cap", a.extraCap,
+                "--progressive: a pixel takes at most this many times --spp eye samples per pass (default 32; "
+                "1: no extra samples)")
+      ->check(rangeOf(kExtraCapRange))->group(group);
 }
 
 void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath,
@@ -65,6 +77,9 @@ void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& s
     if (a.passes) throw Error("--passes needs --progressive (a fixed-budget render has no passes)");
     if (a.timeLimit) throw Error("--time-limit needs --progressive (a fixed-budget render has no passes)");
     if (a.alpha) throw Error("--alpha needs --progressive (a fixed-budget render has no shrinking kernel)");
+    if (a.extraSamples)
+      throw Error("--extra-samples needs --progressive (a fixed-budget render samples adaptively with --max-spp)");
+    if (a.extraCap) throw Error("--extra-cap needs --progressive (a fixed-budget render samples adaptively with --max-spp)");
     if (sc.passes && sceneKeysApply)
       throw Error("render.passes in " + sourcePath + " needs render.progressive true or --progressive");
     if (sc.timeLimit && sceneKeysApply)
@@ -84,7 +99,8 @@ void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& s
                    sourcePath.c_str(), why);
   };
   unused(a.maxSpp && *a.maxSpp > o.spp, sc.maxSpp && *sc.maxSpp > o.spp, "--max-spp", "max_spp",
-         "every pass takes --spp samples per pixel; more passes take more");
+         "every pass takes --spp samples per pixel, up to --extra-cap x --spp where the pilot finds noisy eye paths "
+         "(--extra-samples); more passes take more");
   unused(bool(a.frames), bool(sc.frames), "--frames", "frames",
          "passes replace in-between frames: accumulation --progressive renders one stratified time per pass");
   unused(a.search && *a.search == "4d", sc.search && *sc.search == "4d", "--search 4d", "search",
@@ -105,6 +121,8 @@ void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& s
     if (a.timeLimit && !a.passes) o.passes = 0;
   }
   if (a.alpha) o.alpha = *a.alpha;
+  o.passExtraSamples = a.extraSamples.value_or(kDefaultExtraSamples);
+  if (a.extraCap) o.passSampleCap = *a.extraCap;
 }
 
 void addProgressiveMetadata(const ProgressiveState& s, std::map<std::string, std::string>& m) {

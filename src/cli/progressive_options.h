@@ -1,5 +1,6 @@
 // cli/progressive_options.h — the render subcommand's progressive flags
-// (--progressive, --passes, --time-limit, --alpha; scene keys
+// (--progressive, --passes, --time-limit, --alpha, --extra-samples,
+// --extra-cap; scene keys
 // render.progressive, render.passes, render.time_limit), their validation,
 // and what a progressive render adds to the EXR metadata and the summary.
 // Kept apart from render_command.cpp so that the pass loop's CLI is one file.
@@ -13,8 +14,16 @@
 #include "render/progressive_state.h"
 #include "render/renderer.h"
 #include "scene/description.h"
+#include "scene/limits.h"
 
 namespace tdpm::cli {
+
+// --extra-samples when not given: a progressive render spends this fraction
+// more eye samples per pass where an eye-only pilot finds noise
+// (render/sample_allocation.h, docs/photon-map.md section 7).
+constexpr float kDefaultExtraSamples = 0.5f;
+constexpr scene::limits::FloatRange kExtraSamplesRange{0.0f, 64.0f};
+constexpr scene::limits::IntRange kExtraCapRange{1, 64};
 
 void addProgressiveOptions(CLI::App* c, RenderArgs& a);
 

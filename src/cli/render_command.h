@@ -44,6 +44,8 @@ struct RenderArgs {
   std::optional<int> passes;
   std::optional<double> timeLimit;
   std::optional<float> alpha;
+  std::optional<float> extraSamples;  // --extra-samples (render/sample_allocation.h)
+  std::optional<int> extraCap;        // --extra-cap
   int threads = 0;  // 0: all cores
   bool quiet = false;
   bool stats = false;  // --stats: memory, photon and timing figures after the summary

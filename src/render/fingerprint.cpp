@@ -63,7 +63,7 @@ const char* timeKernelName(estimate::TimeKernel k) {
 
 std::map<std::string, std::string> renderSettings(const RenderOptions& o, int width, int height) {
   const estimate::Options& e = o.estimate;
-  return {
+  std::map<std::string, std::string> s = {
       {"method", o.method},
       {"seed", std::to_string(o.seed)},
       {"sampler", samplerName(o.sampler)},
@@ -95,6 +95,12 @@ std::map<std::string, std::string> renderSettings(const RenderOptions& o, int wi
       {"kernel_footprint", floatText(o.kernelFootprint)},
       {"alpha", o.alpha > 0 ? floatText(o.alpha) : "auto"},
   };
+  // Progressive passes' per-pixel sample counts (render/sample_allocation.h):
+  // one key, present only when they are on, so that a render without them
+  // keeps the fingerprint it had before they existed.
+  if (o.passExtraSamples > 0 && o.passSampleCap > 1)
+    s["extra_samples"] = floatText(o.passExtraSamples) + " (cap " + std::to_string(o.passSampleCap) + ")";
+  return s;
 }
 
 std::string sceneDigest(const scene::SceneDescription& d) {

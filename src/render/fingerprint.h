@@ -33,7 +33,9 @@ inline constexpr const char* kSceneSettingKey = "scene";
 // max_depth, photons, global_photons, frames, search, k, ks, fraction,
 // kappa, max_radius ("auto" when unset), max_dt, max_radius_fraction,
 // max_dt_fraction, kernel_space, kernel_time, cone_k, min_radius2, gather,
-// global_direct, resolution ("WxH", from `width` and `height`).
+// global_direct, resolution ("WxH", from `width` and `height`), and
+// extra_samples ("F (cap N)", only when passExtraSamples > 0 and
+// passSampleCap > 1).
 // A new RenderOptions field that changes the image must be added here (and
 // to the test that changes each option in tests/test_fingerprint.cpp).
 std::map<std::string, std::string> renderSettings(const RenderOptions& options, int width, int height);

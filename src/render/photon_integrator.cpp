@@ -125,6 +125,26 @@ Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, flo
 
 template <class Stream>
 Rgb PhotonIntegrator::radiance(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts) const {
+  return trace<Part::All>(origin, dir, time01, sampler, ts, nullptr);
+}
+
+template <class Stream>
+Rgb PhotonIntegrator::radianceSplit(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts,
+                                    Rgb& eye) const {
+  eye = Rgb(0.0f);
+  return trace<Part::Split>(origin, dir, time01, sampler, ts, &eye);
+}
+
+template <class Stream>
+Rgb PhotonIntegrator::eyePart(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts) const {
+  return trace<Part::EyeOnly>(origin, dir, time01, sampler, ts, nullptr);
+}
+
+// The eye path. Part::All is radiance(); Split also sums the eye part into
+// *eye; EyeOnly skips every photon estimate and gather ray (its draws are a
+// prefix of All's: the same path and shadow rays for the same stream).
+template <PhotonIntegrator::Part kPart, class Stream>
+Rgb PhotonIntegrator::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts, Rgb* eye) const {
   Rgb L(0.0f), beta(1.0f);
   // A moving camera sees a different surface point at each time: never
   // the fixed-point time average, so always the time-dependent estimate.
@@ -135,6 +155,7 @@ Rgb PhotonIntegrator::radiance(Vec3f origin, Vec3f dir, float time01, Stream& sa
     Hit hit;
     if (!scene_.intersect(origin, dir, kInf, time01, hit)) {
       L += beta * scene_.background;
+      if constexpr (kPart == Part::Split) *eye = L;
       break;
     }
     pathLength += hit.t;
@@ -145,6 +166,7 @@ Rgb PhotonIntegrator::radiance(Vec3f origin, Vec3f dir, float time01, Stream& sa
         const Light& light = scene_.lights[size_t(hit.light)];
         L += beta * areaLightRadiance(light, areaLightFrame(light, time01), -dir);
       }
+      if constexpr (kPart == Part::Split) *eye = L;
       break;
     }
     const Material& mat = scene_.materials[scene_.objects[hit.object].material];
@@ -154,11 +176,15 @@ Rgb PhotonIntegrator::radiance(Vec3f origin, Vec3f dir, float time01, Stream& sa
     if (!mat.isDeltaOnly()) {
       // ---- gather point ----
       if (s_.visualizeGlobal) {
-        L += beta * estimate(global_, ts.global, ts.global3, hit, ctx, -dir, time01, timeDependent, ts);
+        if constexpr (kPart == Part::Split) *eye = L;
+        if constexpr (kPart != Part::EyeOnly)
+          L += beta * estimate(global_, ts.global, ts.global3, hit, ctx, -dir, time01, timeDependent, ts);
         break;
       }
       bool gather = global_ && global_->size() > 0 && s_.gatherRays > 0;
       L += beta * directLight(scene_, hit, ctx, time01, sampler, depth, gather ? s_.gatherRays : 0);
+      if constexpr (kPart == Part::Split) *eye = L;
+      if constexpr (kPart == Part::EyeOnly) break;
       L += beta * estimate(caustic_, ts.caustic, ts.caustic3, hit, ctx, -dir, time01, timeDependent, ts,
                            s_.footprintVolume * pathLength * pathLength);
       if (gather) L += beta * finalGather(hit, ctx, time01, touched, sampler, depth, ts);
@@ -180,5 +206,10 @@ Rgb PhotonIntegrator::radiance(Vec3f origin, Vec3f dir, float time01, Stream& sa
 
 template Rgb PhotonIntegrator::radiance<RandomStream>(Vec3f, Vec3f, float, RandomStream&, ThreadState&) const;
 template Rgb PhotonIntegrator::radiance<SobolStream>(Vec3f, Vec3f, float, SobolStream&, ThreadState&) const;
+template Rgb PhotonIntegrator::radianceSplit<RandomStream>(Vec3f, Vec3f, float, RandomStream&, ThreadState&,
+                                                           Rgb&) const;
+template Rgb PhotonIntegrator::radianceSplit<SobolStream>(Vec3f, Vec3f, float, SobolStream&, ThreadState&, Rgb&) const;
+template Rgb PhotonIntegrator::eyePart<RandomStream>(Vec3f, Vec3f, float, RandomStream&, ThreadState&) const;
+template Rgb PhotonIntegrator::eyePart<SobolStream>(Vec3f, Vec3f, float, SobolStream&, ThreadState&) const;
 
 }  // namespace tdpm

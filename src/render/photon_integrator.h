@@ -65,6 +65,19 @@ class PhotonIntegrator {
     RandomStream s{&rng};
     return radiance(origin, dir, time01, s, ts);
   }
+  // A sample's eye part: what the eye path finds without the photon maps,
+  // i.e. emission and background seen directly or through mirrors and
+  // glass, and direct light at the gather point with the MIS weight this
+  // integrator gives its shadow rays (the final gather holds the rest).
+  // radianceSplit returns radiance() and puts the eye part of the same
+  // sample (same path, same draws) into `eye`; eyePart computes it alone,
+  // without any photon estimate or gather ray. Progressive passes with
+  // per-pixel sample counts (render/sample_allocation.h) average the eye
+  // part over more samples than the rest: by linearity still unbiased.
+  template <class Stream>
+  Rgb radianceSplit(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts, Rgb& eye) const;
+  template <class Stream>
+  Rgb eyePart(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts) const;
   // Moves a thread's counters into the totals (called once per tile).
   void flush(ThreadState& ts) const;
   EstimateCounts counts() const;
@@ -73,6 +86,9 @@ class PhotonIntegrator {
   Rgb estimate(const PhotonMap* map, std::unique_ptr<estimate::Gatherer>& g, std::unique_ptr<estimate::Gatherer>& g3,
                const Hit& hit, const struct ShadingContext& ctx, Vec3f wo, float time01, bool timeDependent,
                ThreadState& ts, float minVolume = 0.0f) const;
+  enum class Part { All, Split, EyeOnly };
+  template <Part kPart, class Stream>
+  Rgb trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts, Rgb* eye) const;
   template <class Stream>
   Rgb finalGather(const Hit& hit, const struct ShadingContext& ctx, float time01, bool touched, Stream& sampler,
                   int vertex, ThreadState& ts) const;

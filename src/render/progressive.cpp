@@ -24,6 +24,7 @@
 #include "render/memory_budget.h"
 #include "render/photon_integrator.h"
 #include "render/photon_map.h"
+#include "render/sample_allocation.h"
 #include "render/tile_loop.h"
 #include "sampling/sampler.h"
 
@@ -135,13 +136,19 @@ struct Scratch {
   typename Integrator::ThreadState state;
 };
 
-// Eye samples [first, first + spp) of every pixel; their mean goes to
-// `mean` (3 floats a pixel, one pixel per tile task: no locks, any thread
-// count). addPass adds it into the sums.
+// Eye samples [pass m, (pass + 1) m) of every pixel, m = counts[pixel]
+// (render/sample_allocation.h) or `spp` when `counts` is empty, so a pixel's
+// samples continue one sequence across passes; the pixel's pass value goes
+// to `mean` (3 floats a pixel, one pixel per tile task: no locks, any thread
+// count). addPass adds it into the sums. A pixel with m = spp averages full
+// samples; one with m > spp takes full samples for its first spp indices
+// and the eye part alone (PhotonIntegrator::eyePart) for the others, and
+// its value is mean over m of the eye part + mean over spp of the rest:
+// unbiased by linearity, and the extra samples trace no photon gathers.
 template <class PixelSampler>
-void renderPassPixels(const Scene& scene, const PhotonIntegrator& integ, const RenderOptions& opt, uint32_t first,
-                      int spp, float fixedTime01, const std::string& stage, const Progress& progress,
-                      std::vector<float>& mean) {
+void renderPassPixels(const Scene& scene, const PhotonIntegrator& integ, const RenderOptions& opt, int pass,
+                      int spp, const std::vector<uint32_t>& counts, float fixedTime01, const std::string& stage,
+                      const Progress& progress, std::vector<float>& mean) {
   const int w = scene.camera.width(), h = scene.camera.height();
   mean.assign(size_t(w) * size_t(h) * 3, 0.0f);
   float* out = mean.data();
@@ -151,23 +158,56 @@ void renderPassPixels(const Scene& scene, const PhotonIntegrator& integ, const R
     for (int y = t.y0; y < t.y1; ++y)
       for (int x = t.x0; x < t.x1; ++x) {
         size_t idx = size_t(y) * size_t(w) + size_t(x);
+        const uint32_t m = counts.empty() ? uint32_t(spp) : counts[idx];
+        const uint32_t first = uint32_t(pass) * m;
         PixelSampler ps(opt.seed, idx);
-        ps.startBatch(first, spp);
-        double acc[3] = {0, 0, 0};
-        for (uint32_t i = first; i < first + uint32_t(spp); ++i) {
+        ps.startBatch(first, int(m));
+        // Sample i's camera ray, and its stream.
+        auto ray = [&](uint32_t i, Vec3f& o, Vec3f& d) {
           CameraSample cs = ps.camera(i);
           if (fixedTime01 >= 0) cs.time01 = fixedTime01;
           else if (!scene.hasMotion) cs.time01 = 0.0f;
-          Vec3f o, d;
           Vec2f p = filter.sample(cs.pixelOffset);  // filter importance sampling: weight 1
           cam.generateRay({float(x) + p.x, float(y) + p.y}, cs.time01, o, d);
-          typename PixelSampler::Stream stream = ps.stream(i);
-          Rgb L = integ.radiance(o, d, cs.time01, stream, s.state);
-          if (!isFinite(L)) L = saturateSample(L);
-          for (int c = 0; c < 3; ++c) acc[c] += double(L[c]);
+          return cs.time01;
+        };
+        Rgb v;
+        if (m == uint32_t(spp)) {
+          double acc[3] = {0, 0, 0};
+          for (uint32_t i = first; i < first + m; ++i) {
+            Vec3f o, d;
+            float t01 = ray(i, o, d);
+            typename PixelSampler::Stream stream = ps.stream(i);
+            Rgb L = integ.radiance(o, d, t01, stream, s.state);
+            if (!isFinite(L)) L = saturateSample(L);
+            for (int c = 0; c < 3; ++c) acc[c] += double(L[c]);
+          }
+          const double dm = double(m);
+          v = saturateSample(Rgb(float(acc[0] / dm), float(acc[1] / dm), float(acc[2] / dm)));
+        } else {
+          double eye[3] = {0, 0, 0}, rest[3] = {0, 0, 0};
+          for (uint32_t i = first; i < first + m; ++i) {
+            Vec3f o, d;
+            float t01 = ray(i, o, d);
+            typename PixelSampler::Stream stream = ps.stream(i);
+            Rgb e, L(0.0f);
+            if (i < first + uint32_t(spp)) {
+              L = saturateSample(integ.radianceSplit(o, d, t01, stream, s.state, e));
+              e = saturateSample(e);
+              L = saturateSample(L - e);
+            } else {
+              e = saturateSample(integ.eyePart(o, d, t01, stream, s.state));
+            }
+            for (int c = 0; c < 3; ++c) {
+              eye[c] += double(e[c]);
+              rest[c] += double(L[c]);
+            }
+          }
+          Rgb r;
+          for (int c = 0; c < 3; ++c) r[c] = float(eye[c] / double(m) + rest[c] / double(spp));
+          v = saturateSample(r);
         }
-        Rgb m = saturateSample(Rgb(float(acc[0] / spp), float(acc[1] / spp), float(acc[2] / spp)));
-        for (int c = 0; c < 3; ++c) out[3 * idx + size_t(c)] = m[c];
+        for (int c = 0; c < 3; ++c) out[3 * idx + size_t(c)] = v[c];
       }
     integ.flush(s.state);
   });
@@ -218,8 +258,8 @@ void sharePilot(dist::Comm& comm, ProgressiveState& s) {
 // computes them into it and then calls `afterPilot` (may be empty). Only
 // warnings go to `st`; the rest is in the figures, for addPass.
 PassFigures computePass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state, int pass,
-                        const Progress& progress, RenderStats& st, std::vector<float>& mean,
-                        const std::function<void()>& afterPilot) {
+                        const std::vector<uint32_t>& counts, const Progress& progress, RenderStats& st,
+                        std::vector<float>& mean, const std::function<void()>& afterPilot) {
   Timer timer;
   const bool accumulation = opt.method == "accumulation";
   const bool spread = !accumulation && scene.hasMotion;
@@ -274,11 +314,10 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
   is.globalKernel = k.global;
   PhotonIntegrator integ(scene, caustic.get(), global.get(), is);
   std::string stage = "pass " + std::to_string(pass + 1) + " render";
-  uint32_t first = uint32_t(pass) * uint32_t(opt.spp);
   if (opt.sampler == SamplerKind::Random)
-    renderPassPixels<RandomPixelSampler>(scene, integ, opt, first, opt.spp, passTime, stage, progress, mean);
+    renderPassPixels<RandomPixelSampler>(scene, integ, opt, pass, opt.spp, counts, passTime, stage, progress, mean);
   else
-    renderPassPixels<SobolPixelSampler>(scene, integ, opt, first, opt.spp, passTime, stage, progress, mean);
+    renderPassPixels<SobolPixelSampler>(scene, integ, opt, pass, opt.spp, counts, passTime, stage, progress, mean);
 
   PassFigures f;
   EstimateCounts c = integ.counts();
@@ -301,7 +340,7 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
 // the one place the sums grow, for one process and for rank 0 of a job
 // alike, so both make the same float operations in the same order.
 void addPass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state, const float* mean,
-             const PassFigures& f, RenderStats& st) {
+             const std::vector<uint32_t>& counts, const PassFigures& f, RenderStats& st) {
   const int pass = state.passesDone;
   const size_t n = size_t(scene.camera.width()) * size_t(scene.camera.height());
   float* sum[3] = {state.layers["sum.R"].data(), state.layers["sum.G"].data(), state.layers["sum.B"].data()};
@@ -314,7 +353,7 @@ void addPass(const Scene& scene, const RenderOptions& opt, ProgressiveState& sta
       sum[c][i] += m;
       sq[c][i] += m * m;
     }
-    count[i] += spp;
+    count[i] += counts.empty() ? spp : float(counts[i]);
   }
   st.standardEstimates += uint64_t(f.standardEstimates);
   st.timeEstimates += uint64_t(f.timeEstimates);
@@ -387,10 +426,10 @@ PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& o
 }
 
 void runProgressivePass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
-                        const Progress& progress, RenderStats& st) {
+                        const Progress& progress, RenderStats& st, const std::vector<uint32_t>& counts) {
   std::vector<float> mean;
-  PassFigures f = computePass(scene, opt, state, state.passesDone, progress, st, mean, {});
-  addPass(scene, opt, state, mean.data(), f, st);
+  PassFigures f = computePass(scene, opt, state, state.passesDone, counts, progress, st, mean, {});
+  addPass(scene, opt, state, mean.data(), counts, f, st);
 }
 
 Film filmFromState(const ProgressiveState& state, int width, int height) {
@@ -482,10 +521,13 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
                         uint64_t(scalarOr(state, "photons.emitted", 0))};
   };
   progress.at(position());
+  // Samples per pixel and pass: the same map in every run and on every rank
+  // (a function of scene, options and seed; render/sample_allocation.h).
+  const std::vector<uint32_t> counts = passSampleCounts(scene, opt, progress, comm);
   if (!comm.distributed()) {
     for (;;) {
       if (opt.passes > 0 && state.passesDone >= opt.passes) break;
-      runProgressivePass(scene, opt, state, progress, st);
+      runProgressivePass(scene, opt, state, progress, st, counts);
       progress.at(position());
       if (limit > 0 && timer.seconds() >= limit) break;
       if (signals::stopRequested()) break;
@@ -509,7 +551,7 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
       std::vector<double> figures;
       if (has) {
         RenderStats own;  // warnings (rank 0's pass 0 only)
-        PassFigures f = computePass(scene, opt, state, first + rank, comm.root() ? progress : Progress{}, own, mean,
+        PassFigures f = computePass(scene, opt, state, first + rank, counts, comm.root() ? progress : Progress{}, own, mean,
                                     [&] { if (needPilot) sharePilot(comm, state); });
         if (comm.root()) st.warnings.insert(st.warnings.end(), own.warnings.begin(), own.warnings.end());
         figures = f.pack();
@@ -519,7 +561,7 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
                                [&](const double* v, size_t) { roundFigures.push_back(PassFigures::unpack(v)); });
       size_t next = 0;
       dist::combineRoundOnRoot(comm, mean, has, [&](const float* v, size_t) {
-        addPass(scene, opt, state, v, roundFigures[next++], st);
+        addPass(scene, opt, state, v, counts, roundFigures[next++], st);
       });
       state.passesDone = first + inRound;
       if (comm.root()) progress.at(position());

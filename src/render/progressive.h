@@ -2,7 +2,8 @@
 // docs/photon-map.md "Progressive passes"). A render is a sequence of
 // passes; pass i (0-based) traces fresh photon maps (global photon path
 // indices continue those of passes 0..i-1), renders eye samples
-// [i spp, (i+1) spp) of every pixel with kernels fixed for the pass
+// [i m_p, (i+1) m_p) of every pixel p (m_p = spp, or the pilot's count with
+// opt.passExtraSamples > 0: render/sample_allocation.h) with kernels fixed for the pass
 // (estimate/fixed_kernel.h), and adds the pixel means into running float
 // sums: the image is their mean. Memory is one pass's, whatever the count.
 //
@@ -20,7 +21,9 @@
 // pass index), so a run of 2N passes and a run of N resumed for N more give
 // bit-identical images; combining states is summation of their layers.
 #pragma once
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/progress.h"
 #include "dist/comm.h"
@@ -61,9 +64,11 @@ PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& o
 // inverse of the pass index, rotated by a hash of the seed.
 float accumulationPassTime(int pass, uint64_t seed);
 
-// Runs one pass (index state.passesDone) and adds it into `state`.
+// Runs one pass (index state.passesDone) and adds it into `state`; pixel p
+// takes counts[p] eye samples (render/sample_allocation.h), or opt.spp when
+// `counts` is empty.
 void runProgressivePass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
-                        const Progress& progress, RenderStats& stats);
+                        const Progress& progress, RenderStats& stats, const std::vector<uint32_t>& counts = {});
 
 // The pass loop: continues `state` (empty: from pass 0) until opt.passes
 // passes are done in all, or this run has taken opt.timeLimitSeconds (after

@@ -90,6 +90,13 @@ struct RenderOptions {
   int passes = 0;                 // stop once this many passes are done in all (0: the time limit decides)
   double timeLimitSeconds = 0;    // > 0: stop after the pass that reaches it (this run's seconds)
   float alpha = 0;                // > 0: overrides the variant's alpha (docs/photon-map.md)
+  // Eye samples where the eye paths are noisy (render/sample_allocation.h):
+  // every pass gives pixel p m_p in [spp, passSampleCap x spp] samples from
+  // an eye-only pilot, with at most passExtraSamples x spp x pixels above
+  // spp in all. 0: spp everywhere (the CLI's default for progressive renders
+  // is cli/progressive_options.h's kDefaultExtraSamples).
+  float passExtraSamples = 0;
+  int passSampleCap = 32;
 };
 
 struct RenderStats {
