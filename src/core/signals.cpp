@@ -1,4 +1,4 @@
-// core/signals.cpp — SIGINT/SIGTERM handlers, the temporary-file registry
+// core/signals.cpp — SIGINT/SIGTERM/SIGHUP/SIGUSR1 handlers, the temporary-file registry
 // and deferral. Only async-signal-safe calls inside the handler.
 #include "core/signals.h"
 
@@ -42,9 +42,10 @@ void unlinkTemporaries() {
 [[noreturn]] void terminate(int signo) {
   unlinkTemporaries();
   // Starts with a newline: a progress bar may hold the current line.
-  writeStderr(signo == SIGINT    ? "\ntdpm: interrupted by SIGINT (temporary files removed)\n"
-              : signo == SIGHUP ? "\ntdpm: hung up (SIGHUP; temporary files removed)\n"
-                                : "\ntdpm: terminated by SIGTERM (temporary files removed)\n");
+  writeStderr(signo == SIGINT     ? "\ntdpm: interrupted by SIGINT (temporary files removed)\n"
+              : signo == SIGHUP  ? "\ntdpm: hung up (SIGHUP; temporary files removed)\n"
+              : signo == SIGUSR1 ? "\ntdpm: stopped by SIGUSR1 (temporary files removed)\n"
+                                 : "\ntdpm: terminated by SIGTERM (temporary files removed)\n");
   struct sigaction sa;
   std::memset(&sa, 0, sizeof sa);
   sa.sa_handler = SIG_DFL;
@@ -78,7 +79,7 @@ void install(Mode mode) {
   gMode.store(int(mode));
   bool expected = false;
   if (!gInstalled.compare_exchange_strong(expected, true)) return;
-  for (int signo : {SIGINT, SIGTERM, SIGHUP}) {
+  for (int signo : {SIGINT, SIGTERM, SIGHUP, SIGUSR1}) {
     struct sigaction old;
     if (::sigaction(signo, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
     struct sigaction sa;
@@ -88,6 +89,7 @@ void install(Mode mode) {
     sigaddset(&sa.sa_mask, SIGINT);  // one handler at a time
     sigaddset(&sa.sa_mask, SIGTERM);
     sigaddset(&sa.sa_mask, SIGHUP);
+    sigaddset(&sa.sa_mask, SIGUSR1);
     sa.sa_flags = SA_RESTART;
     ::sigaction(signo, &sa, nullptr);
   }
