@@ -492,6 +492,7 @@ int runRender(const RenderArgs& a) {
   // current pass and the passes done are written; a second one aborts. Under
   // mpirun all but SIGUSR1 drop the round in flight (render/progressive.cpp).
   if (opt.progressive) signals::setMode(signals::Mode::Stop);
+  signals::setStopNotice(comm.root());
   bool passLines = opt.progressive && !a.quiet && !ProgressBar::shouldShow(a.quiet);
   Film film = opt.progressive ? renderProgressive(*scene, opt, progressiveState,
                                                   passLines ? withPassLines(bar.progress()) : bar.progress(), stats,

@@ -24,6 +24,7 @@ std::atomic<int> gStop{0};         // signo of the first signal
 std::atomic<int> gDeferrals{0};    // live Deferral objects
 std::atomic<int> gPending{0};      // signo postponed by a Deferral
 std::atomic<bool> gInstalled{false};
+std::atomic<bool> gSayStopping{true};  // the stop mode's "stopping" line
 
 static_assert(std::atomic<int>::is_always_lock_free, "signal handler needs lock-free atomics");
 
@@ -63,7 +64,7 @@ void handler(int signo) {
   int first = 0;
   bool isFirst = gStop.compare_exchange_strong(first, signo);
   if (isFirst && gMode.load() == int(Mode::Stop)) {
-    writeStderr("\ntdpm: stopping (send the signal again to abort at once)\n");
+    if (gSayStopping.load()) writeStderr("\ntdpm: stopping (send the signal again to abort at once)\n");
     return;
   }
   if (gDeferrals.load() > 0) {
@@ -96,6 +97,8 @@ void install(Mode mode) {
 }
 
 void setMode(Mode mode) { gMode.store(int(mode)); }
+
+void setStopNotice(bool on) { gSayStopping.store(on); }
 
 int stopRequested() { return gStop.load(); }
 

@@ -28,6 +28,10 @@ enum class Mode {
 // background jobs) stays ignored.
 void install(Mode mode = Mode::Exit);
 void setMode(Mode mode);
+// Whether the first signal in Stop mode prints "tdpm: stopping ..." (on by
+// default; off on the ranks of an mpirun job other than rank 0, so that
+// a signal mpirun forwards to every rank is announced once).
+void setStopNotice(bool on);
 
 // The signal number that asked to stop, 0 if none.
 int stopRequested();
