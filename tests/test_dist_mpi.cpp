@@ -6,11 +6,19 @@
 // registers a skipped test otherwise). Small images and few photons.
 #include <doctest/doctest.h>
 
-#include <algorithm>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
+#include <csignal>
 #include <cstring>
+#include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
+#include <thread>
 
 #include "cli_harness.h"
 #include "image/exr.h"
@@ -108,6 +116,78 @@ void checkSameProgressive(int ranks, int passes) {
   REQUIRE(fewer.exitCode == 0);
   CHECK_FALSE(sameBits(a, image::readExr(dir + "/fewer.exr")));
   std::system(("rm -rf '" + dir + "'").c_str());
+}
+
+std::string readText(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+// An `mpirun -np 2` job of a progressive render with endless passes, each
+// rank through `sh rank.sh`, which records the rank's pid in pid.RANK (the
+// signal goes to mpirun, or to every rank as mpirun does on Ctrl-C).
+// Output (stdout and stderr of mpirun and the ranks) in `log`.
+struct ProgressiveJob {
+  std::string dir, log, exr;
+  pid_t mpirun = -1;
+
+  explicit ProgressiveJob(const std::string& d) : dir(d), log(d + "/log"), exr(d + "/job.exr") {
+    std::ofstream(dir + "/rank.sh") << "echo $$ > '" << dir << "/pid.'$OMPI_COMM_WORLD_RANK\n"
+                                    << "exec '" << TDPM_BINARY << "' " << progressiveArgsLoud()
+                                    << "--passes 100000 -t 1 -o '" << exr << "'\n";
+    mpirun = ::fork();
+    if (mpirun == 0) {
+      std::string cmd = std::string("OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 exec '") +
+                        TDPM_MPIEXEC + "' --oversubscribe -np 2 sh '" + dir + "/rank.sh' > '" + log +
+                        "' 2>&1 < /dev/null";
+      ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+  }
+  // progressiveArgs() without -q: rank 0 prints a line per round.
+  static std::string progressiveArgsLoud() {
+    return "render '" + std::string(TDPM_SOURCE_DIR) + "/scenes/cube-caustic.json' -m time --progressive"
+           " --resolution 48x32 --spp 2 --photons 4000 --global-photons 1000 --seed 7 ";
+  }
+  // Waits for `marker` in the log while the job runs. A guard against a
+  // hang, not a timed assertion: the limit is far above any normal run.
+  bool waitFor(const std::string& marker) const {
+    for (int i = 0; i < 12000; ++i) {
+      if (readText(log).find(marker) != std::string::npos) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return false;
+  }
+  pid_t rankPid(int rank) const { return pid_t(std::atol(readText(dir + "/pid." + std::to_string(rank)).c_str())); }
+  // mpirun's exit status (-1: killed because it hung for minutes).
+  int wait() {
+    for (int i = 0; i < 12000; ++i) {
+      int status = 0;
+      if (::waitpid(mpirun, &status, WNOHANG) == mpirun) return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ::kill(mpirun, SIGKILL);
+    ::waitpid(mpirun, nullptr, 0);
+    return -1;
+  }
+};
+
+// The job's EXR equals one process's render of as many passes as it says
+// it holds (a whole number of rounds of 2). Returns those passes.
+int checkWrittenPasses(const std::string& dir, const std::string& exr) {
+  image::ExrFile job = image::readExr(exr);
+  int passes = std::atoi(job.metadata["tdpm/progressive/passes"].c_str());
+  CHECK(passes >= 2);
+  CHECK(passes % 2 == 0);
+  CommandResult one = test::runTdpm(progressiveArgs() + "--passes " + std::to_string(passes) + " -t 2 -o " + dir +
+                                    "/one.exr");
+  REQUIRE_MESSAGE(one.exitCode == 0, one.output);
+  image::ExrFile a = image::readExr(dir + "/one.exr");
+  CHECK_MESSAGE(sameBits(a, job), "the interrupted job's " << passes << " passes differ from one process");
+  CHECK(progressiveAttributes(a) == progressiveAttributes(job));
+  return passes;
 }
 
 }  // namespace
@@ -252,6 +332,49 @@ TEST_CASE("mpi: progressive under mpirun resumes a one-process state, and stops 
   CHECK(occurrences(bad.output, "tdpm: error: --resume " + dir + "/missing.exr") == 1);
   CHECK(occurrences(bad.output, "rank-exit 1") == 2);
   CHECK_FALSE(test::fileExists(dir + "/bad.exr"));
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
+// Stopping a progressive job by a signal (docs/distributed.md): whenever it
+// lands, the output holds whole rounds and equals one process's render of
+// those passes, bit for bit. No assertion on how long anything takes.
+TEST_CASE("mpi: a signal stops a progressive job, which writes the rounds done, bit-identical to one process") {
+  std::string dir = test::makeTempDir();
+  SUBCASE("SIGUSR1 to mpirun: forwarded to every rank, the round ends, exit status 0") {
+    ProgressiveJob job(dir);
+    REQUIRE_MESSAGE(job.waitFor("tdpm: pass 2 of 100000 done"), readText(job.log));
+    ::kill(job.mpirun, SIGUSR1);
+    int status = job.wait();
+    std::string out = readText(job.log);
+    INFO(out);
+    CHECK(status == 0);
+    CHECK(occurrences(out, "tdpm: stopped by SIGUSR1 after pass") == 1);
+    checkWrittenPasses(dir, job.exr);
+  }
+  SUBCASE("SIGTERM to every rank (what mpirun sends on Ctrl-C): the round in flight is dropped") {
+    ProgressiveJob job(dir);
+    REQUIRE_MESSAGE(job.waitFor("tdpm: pass 2 of 100000 done"), readText(job.log));
+    pid_t r0 = job.rankPid(0), r1 = job.rankPid(1);
+    REQUIRE(r0 > 0);
+    REQUIRE(r1 > 0);
+    ::kill(r1, SIGTERM);
+    ::kill(r0, SIGTERM);
+    int status = job.wait();
+    std::string out = readText(job.log);
+    INFO(out);
+    CHECK(status == 0);
+    CHECK(occurrences(out, "tdpm: stopped by SIGTERM after pass") == 1);
+    checkWrittenPasses(dir, job.exr);
+  }
+  SUBCASE("SIGINT to mpirun (Ctrl-C): the rounds done, or nothing if Open MPI's SIGKILL came first; never a broken file") {
+    ProgressiveJob job(dir);
+    REQUIRE_MESSAGE(job.waitFor("tdpm: pass 2 of 100000 done"), readText(job.log));
+    ::kill(job.mpirun, SIGINT);
+    CHECK(job.wait() >= 0);  // ended (mpirun's status after an interrupt is not 0)
+    INFO(readText(job.log));
+    if (test::fileExists(job.exr)) checkWrittenPasses(dir, job.exr);
+    else MESSAGE("killed before rank 0 wrote (Open MPI's SIGKILL one second after SIGTERM)");
+  }
   std::system(("rm -rf '" + dir + "'").c_str());
 }
 

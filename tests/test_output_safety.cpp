@@ -368,7 +368,7 @@ TEST_CASE("output safety: render writes through a symlinked output pair") {
 // In a child: a registered temporary, then SIGTERM: the temporary is gone
 // and the child died by SIGTERM.
 TEST_CASE("output safety: a signal removes registered temporaries and ends the process by that signal") {
-  for (int signo : {SIGTERM, SIGHUP, SIGINT}) {
+  for (int signo : {SIGTERM, SIGHUP, SIGINT, SIGUSR1}) {
     CAPTURE(signo);
     const std::string dir = test::makeTempDir();
     int pipeFd[2];

@@ -28,8 +28,8 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a) {
               "Render in passes, each with fresh photons and fixed kernels that shrink from pass to pass, averaged "
               "into the image: converges in the memory of one pass (docs/photon-map.md). Photon counts are per pass; "
               "--spp is the samples per pixel of each pass. Stops after --passes, or after the pass that reaches "
-              "--time-limit (default: 30 s when neither is given); SIGINT/SIGTERM stop after the current pass and "
-              "write the passes done. This is the default when a scene is rendered with its own photon method (its render.method, "
+              "--time-limit (default: 30 s when neither is given); SIGINT/SIGTERM/SIGUSR1 stop after the current pass and "
+              "write the passes done (under mpirun SIGINT/SIGTERM drop the round in flight, SIGUSR1 to mpirun lets it end). This is the default when a scene is rendered with its own photon method (its render.method, "
               "or time) and neither -m, --fixed-budget nor render.progressive says otherwise. Under mpirun each rank runs its own passes, one per rank per round, and the "
               "image equals one process's with the same passes (docs/distributed.md)")
       ->group(group);

@@ -494,9 +494,11 @@ int runRender(const RenderArgs& a) {
     for (const std::string& w : accumulationSppWarnings(opt, scene->hasMotion))
       std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
   RenderStats stats;
-  // Progressive: the first SIGINT/SIGTERM/SIGHUP ends the loop after the
-  // current pass and the passes done are written; a second one aborts.
+  // Progressive: the first SIGINT/SIGTERM/SIGHUP/SIGUSR1 ends the loop after the
+  // current pass and the passes done are written; a second one aborts. Under
+  // mpirun all but SIGUSR1 drop the round in flight (render/progressive.cpp).
   if (opt.progressive) signals::setMode(signals::Mode::Stop);
+  signals::setStopNotice(comm.root());
   bool passLines = opt.progressive && !a.quiet && !ProgressBar::shouldShow(a.quiet);
   Film film = opt.progressive ? renderProgressive(*scene, opt, progressiveState,
                                                   passLines ? withPassLines(bar.progress()) : bar.progress(), stats,
@@ -559,7 +561,11 @@ int runRender(const RenderArgs& a) {
     std::fprintf(stderr, "tdpm: progressive: %s\n", progressiveSummaryText.c_str());
   if (int sig = signals::stopRequested())
     std::fprintf(stderr, "tdpm: stopped by %s after pass %d: wrote the %d passes done to %s\n",
-                 sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "a signal",
+                 sig == SIGINT    ? "SIGINT"
+                 : sig == SIGTERM ? "SIGTERM"
+                 : sig == SIGHUP  ? "SIGHUP"
+                 : sig == SIGUSR1 ? "SIGUSR1"
+                                  : "a signal",
                  passesDone, passesDone, output.c_str());
   if (a.stats) {
     printStats(stats);

@@ -1,4 +1,4 @@
-// core/signals.cpp — SIGINT/SIGTERM handlers, the temporary-file registry
+// core/signals.cpp — SIGINT/SIGTERM/SIGHUP/SIGUSR1 handlers, the temporary-file registry
 // and deferral. Only async-signal-safe calls inside the handler.
 #include "core/signals.h"
 
@@ -24,6 +24,7 @@ std::atomic<int> gStop{0};         // signo of the first signal
 std::atomic<int> gDeferrals{0};    // live Deferral objects
 std::atomic<int> gPending{0};      // signo postponed by a Deferral
 std::atomic<bool> gInstalled{false};
+std::atomic<bool> gSayStopping{true};  // the stop mode's "stopping" line
 
 static_assert(std::atomic<int>::is_always_lock_free, "signal handler needs lock-free atomics");
 
@@ -42,9 +43,10 @@ void unlinkTemporaries() {
 [[noreturn]] void terminate(int signo) {
   unlinkTemporaries();
   // Starts with a newline: a progress bar may hold the current line.
-  writeStderr(signo == SIGINT    ? "\ntdpm: interrupted by SIGINT (temporary files removed)\n"
-              : signo == SIGHUP ? "\ntdpm: hung up (SIGHUP; temporary files removed)\n"
-                                : "\ntdpm: terminated by SIGTERM (temporary files removed)\n");
+  writeStderr(signo == SIGINT     ? "\ntdpm: interrupted by SIGINT (temporary files removed)\n"
+              : signo == SIGHUP  ? "\ntdpm: hung up (SIGHUP; temporary files removed)\n"
+              : signo == SIGUSR1 ? "\ntdpm: stopped by SIGUSR1 (temporary files removed)\n"
+                                 : "\ntdpm: terminated by SIGTERM (temporary files removed)\n");
   struct sigaction sa;
   std::memset(&sa, 0, sizeof sa);
   sa.sa_handler = SIG_DFL;
@@ -62,7 +64,7 @@ void handler(int signo) {
   int first = 0;
   bool isFirst = gStop.compare_exchange_strong(first, signo);
   if (isFirst && gMode.load() == int(Mode::Stop)) {
-    writeStderr("\ntdpm: stopping (send the signal again to abort at once)\n");
+    if (gSayStopping.load()) writeStderr("\ntdpm: stopping (send the signal again to abort at once)\n");
     return;
   }
   if (gDeferrals.load() > 0) {
@@ -78,7 +80,7 @@ void install(Mode mode) {
   gMode.store(int(mode));
   bool expected = false;
   if (!gInstalled.compare_exchange_strong(expected, true)) return;
-  for (int signo : {SIGINT, SIGTERM, SIGHUP}) {
+  for (int signo : {SIGINT, SIGTERM, SIGHUP, SIGUSR1}) {
     struct sigaction old;
     if (::sigaction(signo, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
     struct sigaction sa;
@@ -88,12 +90,15 @@ void install(Mode mode) {
     sigaddset(&sa.sa_mask, SIGINT);  // one handler at a time
     sigaddset(&sa.sa_mask, SIGTERM);
     sigaddset(&sa.sa_mask, SIGHUP);
+    sigaddset(&sa.sa_mask, SIGUSR1);
     sa.sa_flags = SA_RESTART;
     ::sigaction(signo, &sa, nullptr);
   }
 }
 
 void setMode(Mode mode) { gMode.store(int(mode)); }
+
+void setStopNotice(bool on) { gSayStopping.store(on); }
 
 int stopRequested() { return gStop.load(); }
 

@@ -1,4 +1,4 @@
-// core/signals.h — what SIGINT, SIGTERM and SIGHUP do to a tdpm run.
+// core/signals.h — what SIGINT, SIGTERM, SIGHUP and SIGUSR1 do to a tdpm run.
 // Owns: the signal handlers, the registry of temporary files a signal must
 // remove, the "stop requested" flag, and deferral around short critical
 // sections (renaming a finished output pair into place).
@@ -20,11 +20,18 @@ enum class Mode {
   Stop,
 };
 
-// Installs the handlers for SIGINT, SIGTERM and SIGHUP (a closed
-// terminal) (idempotent). A signal the
-// parent set to SIG_IGN (e.g. `nohup`, background jobs) stays ignored.
+// Installs the handlers for SIGINT, SIGTERM, SIGHUP (a closed terminal)
+// and SIGUSR1 (idempotent). SIGUSR1 is the one mpirun forwards to every
+// rank without killing them a second later, as it does after SIGTERM: the
+// documented "stop and write" signal of a progressive job
+// (docs/distributed.md). A signal the parent set to SIG_IGN (e.g. `nohup`,
+// background jobs) stays ignored.
 void install(Mode mode = Mode::Exit);
 void setMode(Mode mode);
+// Whether the first signal in Stop mode prints "tdpm: stopping ..." (on by
+// default; off on the ranks of an mpirun job other than rank 0, so that
+// a signal mpirun forwards to every rank is announced once).
+void setStopNotice(bool on);
 
 // The signal number that asked to stop, 0 if none.
 int stopRequested();

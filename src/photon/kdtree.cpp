@@ -9,9 +9,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "core/error.h"
+#include "dist/comm.h"
 
 namespace tdpm::photon {
 
@@ -95,6 +97,20 @@ struct Builder {
       axes[node] = 0;
       return;
     }
+    size_t m = split(it, n, node);
+    auto left = [&] { build(it, m, 2 * node + 1); };
+    auto right = [&] { build(it + m + 1, n - m - 1, 2 * node + 2); };
+    if (n >= cutoff) {
+      tbb::parallel_invoke(left, right);
+    } else {
+      left();
+      right();
+    }
+  }
+
+  // Node `node` of n >= 2 photons it[0, n): partitions them around the
+  // median of the widest axis, records the node; returns the left subtree's size.
+  size_t split(Item<D>* it, size_t n, size_t node) const {
     Box<D> box = n >= cutoff ? tbb::parallel_reduce(
                                    tbb::blocked_range<size_t>(0, n, 1 << 14), Box<D>{},
                                    [it](const tbb::blocked_range<size_t>& r, Box<D> b) {
@@ -111,20 +127,103 @@ struct Builder {
     std::nth_element(it, it + m, it + n, [axis](const Item<D>& a, const Item<D>& b) { return a.k[axis] < b.k[axis]; });
     order[node] = it[m].idx;
     axes[node] = uint8_t(axis);
-    auto left = [&] { build(it, m, 2 * node + 1); };
-    auto right = [&] { build(it + m + 1, n - m - 1, 2 * node + 2); };
-    if (n >= cutoff) {
-      tbb::parallel_invoke(left, right);
-    } else {
-      left();
-      right();
-    }
+    return m;
   }
 };
 
+// ---- the build split over the ranks of an mpirun job ----
+
+// Below this many photons every rank builds the whole tree (the exchange
+// would cost more than it saves).
+constexpr size_t kDistributedBuildMin = size_t(1) << 14;
+
+// A subtree below the top splits: its heap root and its photons' range in
+// the items array.
+struct Subtree {
+  size_t node, first, n;
+};
+
+// Heap slots of the subtree rooted at `root` in a heap of `total` nodes,
+// level by level (each level's slots are contiguous).
+template <class Fn>
+void forEachSlot(size_t root, size_t total, Fn&& fn) {
+  for (size_t lo = root, width = 1; lo < total; lo = 2 * lo + 1, width *= 2)
+    for (size_t i = lo; i < std::min(lo + width, total); ++i) fn(i);
+}
+
 template <int D>
-void buildTree(const PhotonStore& store, const float* timeKey, size_t cutoff, std::vector<uint32_t>& order,
-               std::vector<uint8_t>& axes) {
+void topSplits(const Builder<D>& b, Item<D>* items, size_t first, size_t n, size_t node, int depth,
+               std::vector<Subtree>& out) {
+  if (depth == 0 || n < 2) {
+    out.push_back({node, first, n});
+    return;
+  }
+  size_t m = b.split(items + first, n, node);
+  topSplits(b, items, first, m, 2 * node + 1, depth - 1, out);
+  topSplits(b, items, first + m + 1, n - m - 1, 2 * node + 2, depth - 1, out);
+}
+
+template <int D>
+void buildDistributed(const Builder<D>& b, Item<D>* items, size_t n, dist::Comm& comm) {
+  const int ranks = comm.size();
+  // Two subtrees per rank or more, dealt largest first to the least loaded
+  // rank: balanced within a few percent however lopsided the left-balanced
+  // split (the root's left subtree may hold 2/3 of the photons).
+  int depth = 1;
+  while ((1 << depth) < 2 * ranks) ++depth;
+  std::vector<Subtree> subtrees;
+  topSplits(b, items, 0, n, 0, depth, subtrees);
+  std::vector<size_t> byWork(subtrees.size());
+  for (size_t i = 0; i < byWork.size(); ++i) byWork[i] = i;
+  std::stable_sort(byWork.begin(), byWork.end(), [&](size_t a, size_t c) { return subtrees[a].n > subtrees[c].n; });
+  std::vector<int> owner(subtrees.size());
+  std::vector<uint64_t> load(static_cast<size_t>(ranks), 0);
+  for (size_t i : byWork) {
+    int r = int(std::min_element(load.begin(), load.end()) - load.begin());
+    owner[i] = r;
+    load[size_t(r)] += subtrees[i].n;
+  }
+  // Build this rank's subtrees, pack their slots (index, then axis), in subtree order.
+  std::vector<uint64_t> bytes(static_cast<size_t>(ranks));
+  for (int r = 0; r < ranks; ++r) bytes[size_t(r)] = load[size_t(r)] * 5;
+  std::vector<uint8_t> mine(static_cast<size_t>(bytes[static_cast<size_t>(comm.rank())]));
+  size_t packed = 0;
+  for (size_t i = 0; i < subtrees.size(); ++i) {
+    if (owner[i] != comm.rank()) continue;
+    const Subtree& t = subtrees[i];
+    b.build(items + t.first, t.n, t.node);
+    forEachSlot(t.node, n, [&](size_t slot) {
+      TDPM_ASSERT(packed + 5 <= mine.size(), "distributed kd-tree: subtree slots miscounted");
+      std::memcpy(&mine[packed], &b.order[slot], 4);
+      mine[packed + 4] = b.axes[slot];
+      packed += 5;
+    });
+  }
+  TDPM_ASSERT(packed == mine.size(), "distributed kd-tree: subtree slots miscounted");
+  uint64_t total = 0;
+  for (uint64_t x : bytes) total += x;
+  std::vector<uint8_t> all(static_cast<size_t>(total));
+  comm.allgatherv(mine.data(), all.data(), bytes);
+  // Unpack every other rank's subtrees: rank r's bytes hold its subtrees in subtree order.
+  std::vector<size_t> offset(static_cast<size_t>(ranks), 0);
+  for (int r = 1; r < ranks; ++r) offset[size_t(r)] = offset[size_t(r - 1)] + size_t(bytes[size_t(r - 1)]);
+  for (size_t i = 0; i < subtrees.size(); ++i) {
+    size_t& at = offset[size_t(owner[i])];
+    if (owner[i] == comm.rank()) {
+      at += subtrees[i].n * 5;
+      continue;
+    }
+    forEachSlot(subtrees[i].node, n, [&](size_t slot) {
+      std::memcpy(&b.order[slot], &all[at], 4);
+      b.axes[slot] = all[at + 4];
+      at += 5;
+    });
+  }
+}
+
+template <int D>
+void buildTree(const PhotonStore& store, const float* timeKey, size_t cutoff, dist::Comm* comm,
+               std::vector<uint32_t>& order, std::vector<uint8_t>& axes) {
   size_t n = store.size();
   std::vector<Item<D>> items(n);
   const float *X = store.xs(), *Y = store.ys(), *Z = store.zs();
@@ -142,7 +241,10 @@ void buildTree(const PhotonStore& store, const float* timeKey, size_t cutoff, st
   order.resize(n);
   axes.resize(n);
   Builder<D> b{items.data(), order.data(), axes.data(), std::max<size_t>(cutoff, 2)};
-  b.build(items.data(), n, 0);
+  if (comm && comm->distributed() && n >= kDistributedBuildMin)
+    buildDistributed(b, items.data(), n, *comm);
+  else
+    b.build(items.data(), n, 0);
 }
 
 }  // namespace
@@ -165,9 +267,9 @@ KdTree KdTree::build(PhotonStore& store, const KdBuildOptions& options) {
   std::vector<uint32_t>& order = options.order ? *options.order : localOrder;
   std::vector<uint8_t> axes;
   if (options.spaceTime)
-    buildTree<4>(store, timeKey, options.parallelCutoff, order, axes);
+    buildTree<4>(store, timeKey, options.parallelCutoff, options.comm, order, axes);
   else
-    buildTree<3>(store, timeKey, options.parallelCutoff, order, axes);
+    buildTree<3>(store, timeKey, options.parallelCutoff, options.comm, order, axes);
   store.permute(order.data());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, tree.n_, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i != r.end(); ++i) store.setSplitAxis(i, axes[i]);

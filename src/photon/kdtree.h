@@ -21,6 +21,10 @@
 #include "math/vec.h"
 #include "photon/store.h"
 
+namespace tdpm::dist {
+class Comm;
+}
+
 namespace tdpm::photon {
 
 // Reusable per-thread query state and results. After a query, the first
@@ -86,6 +90,12 @@ struct KdBuildOptions {
   // If set, receives order[i] = the index photon i had before the build
   // (lets callers keep side data, e.g. float times in tests, in step).
   std::vector<uint32_t>* order = nullptr;
+  // Under mpirun (a distributed Comm; every rank holds the same store):
+  // every rank makes the top splits, each builds its share of the subtrees
+  // below them, and the subtrees' heap slots (photon index and split axis,
+  // 5 bytes a photon) are allgathered. The tree is the one-process tree,
+  // bit for bit (docs/distributed.md). Collective: every rank calls build.
+  dist::Comm* comm = nullptr;
 };
 
 class KdTree {

@@ -23,9 +23,12 @@ std::unique_ptr<PhotonMap> buildPhotonMap(const Scene& scene, const PhotonMapSet
   photon::KdBuildOptions opt;
   opt.spaceTime = settings.spaceTime;
   opt.kappa = settings.kappa;
+  opt.comm = settings.trace.comm;  // under mpirun the ranks share the build
   if (settings.spaceTime) {
     map->store3 = map->store;
-    map->tree3 = photon::KdTree::build(map->store3, {});
+    photon::KdBuildOptions opt3;
+    opt3.comm = settings.trace.comm;
+    map->tree3 = photon::KdTree::build(map->store3, opt3);
   }
   map->tree = photon::KdTree::build(map->store, opt);
   map->buildSeconds = timer.seconds();

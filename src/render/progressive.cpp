@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -245,12 +247,46 @@ constexpr size_t kPilotCount = sizeof kPilotScalars / sizeof kPilotScalars[0];
 bool hasPilot(const ProgressiveState& s) { return s.scalars.count("kernel.caustic.radius_1") > 0; }
 
 // Rank 0's pilot scalars into every rank's state (collective).
-void sharePilot(dist::Comm& comm, ProgressiveState& s) {
-  double v[kPilotCount] = {};
-  if (comm.root())
+// Rank 0 sends its pilot values; `valid` false (rank 0's pass 0 was
+// cancelled before its pilot ended) tells the others there are none, and
+// they return false without touching their state.
+bool sharePilot(dist::Comm& comm, ProgressiveState& s, bool valid = true) {
+  double v[kPilotCount + 1] = {};
+  if (comm.root()) {
     for (size_t i = 0; i < kPilotCount; ++i) v[i] = scalarOr(s, kPilotScalars[i], 0);
+    v[kPilotCount] = valid ? 1.0 : 0.0;
+  }
   comm.broadcast(v, sizeof v, 0);
+  if (v[kPilotCount] == 0.0) return false;
   for (size_t i = 0; i < kPilotCount; ++i) s.scalars[kPilotScalars[i]] = v[i];
+  return true;
+}
+
+// Under mpirun a pass in flight is abandoned when the rank is asked to stop
+// by SIGINT, SIGTERM or SIGHUP: Ctrl-C on mpirun sends every rank SIGTERM
+// and SIGKILL one second later (Open MPI's odls_base_sigkill_timeout), too
+// soon for a long round to end, so the round is dropped and rank 0 writes
+// the rounds done at once. SIGUSR1, which mpirun forwards and follows with
+// nothing, lets the round end (docs/distributed.md).
+struct PassCancelled : std::exception {
+  const char* what() const noexcept override { return "progressive pass cancelled by a signal"; }
+};
+
+bool cancelRequested() {
+  int signo = signals::stopRequested();
+  return signo != 0 && signo != SIGUSR1;
+}
+
+// `progress` that throws PassCancelled from the next tile or photon batch
+// once cancelRequested() (the tile and photon loops report once per unit;
+// TBB carries the exception to the caller and cancels the other tasks).
+Progress cancellable(const Progress& progress) {
+  Progress p = progress;
+  p.report = [inner = progress.report](const std::string& stage, size_t done, size_t total) {
+    if (cancelRequested()) throw PassCancelled();
+    if (inner) inner(stage, done, total);
+  };
+  return p;
 }
 
 // Renders pass `pass` into `mean` (3 floats a pixel) without touching the
@@ -540,21 +576,40 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
     // rank 0, which sends them before rendering its pixels; the others wait
     // for them, then run their passes.
     const int N = comm.size(), rank = comm.rank();
+    bool roundDropped = false;
     for (bool stop = false; !stop;) {
       const int first = state.passesDone;
       const int inRound = opt.passes > 0 ? std::min(N, opt.passes - first) : N;
       if (inRound <= 0) break;
       const bool has = rank < inRound;
       const bool needPilot = !hasPilot(state);
-      if (needPilot && !comm.root()) sharePilot(comm, state);
+      bool cancelled = false, pilotSent = false;
+      if (needPilot && !comm.root()) cancelled = !sharePilot(comm, state);
       std::vector<float> mean;
       std::vector<double> figures;
-      if (has) {
+      if (has && !cancelled) {
         RenderStats own;  // warnings (rank 0's pass 0 only)
-        PassFigures f = computePass(scene, opt, state, first + rank, counts, comm.root() ? progress : Progress{}, own, mean,
-                                    [&] { if (needPilot) sharePilot(comm, state); });
-        if (comm.root()) st.warnings.insert(st.warnings.end(), own.warnings.begin(), own.warnings.end());
-        figures = f.pack();
+        try {
+          PassFigures f = computePass(scene, opt, state, first + rank, counts, cancellable(comm.root() ? progress : Progress{}),
+                                      own, mean, [&] {
+                                        if (needPilot) sharePilot(comm, state);
+                                        pilotSent = true;
+                                      });
+          if (comm.root()) st.warnings.insert(st.warnings.end(), own.warnings.begin(), own.warnings.end());
+          figures = f.pack();
+        } catch (const PassCancelled&) {
+          cancelled = true;
+        }
+      }
+      if (needPilot && comm.root() && !pilotSent) sharePilot(comm, state, false);  // the others wait for it
+      // A rank that abandoned its pass drops the whole round: the job
+      // stops with the rounds done before it (an integer sum, so every
+      // rank decides alike).
+      uint64_t dropped = cancelled ? 1 : 0;
+      comm.allreduceSum(&dropped, 1);
+      if (dropped > 0) {
+        roundDropped = true;
+        break;
       }
       std::vector<PassFigures> roundFigures;
       dist::combineRoundOnRoot(comm, figures, has,
@@ -571,6 +626,8 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
       comm.allreduceSum(&want, 1);
       stop = want > 0;
     }
+    if (roundDropped && state.passesDone == 0)  // every rank knows: an agreed error, rank 0 says it
+      throw dist::AgreedError("stopped by a signal before the first round of passes ended: nothing to write");
     if (!comm.root()) {
       st.seconds = timer.seconds();
       return Film();

@@ -2,14 +2,17 @@
 // job, run by tests/test_dist_mpi.cpp as `mpirun -np 3 tdpm_dist_selftest`:
 // uneven allgather / gather, broadcast from a rank other than 0, integer
 // sums, error agreement, pixel sharing over the tile interleave, and a
-// progressive round combined in rank order with a rank that has no unit.
+// progressive round combined in rank order with a rank that has no unit,
+// and the kd-tree built by the ranks together equal to one built alone.
 // Prints one line per failed check; exit status 0 when every rank passed.
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
 #include "dist/comm.h"
+#include "photon/kdtree.h"
 #include "render/pixel_share.h"
 
 using namespace tdpm;
@@ -107,6 +110,38 @@ int main(int argc, char** argv) {
     std::vector<int> want;
     for (int r = 0; r < n - 1; ++r) want.push_back(r);
     check(order == want, comm, "combineRoundOnRoot adds units in rank order and skips a rank without one");
+  }
+
+  // The kd-tree built by the ranks together (photon/kdtree.h, options.comm)
+  // equals the one built alone, slot for slot: the same photons in the same
+  // heap order with the same split axes (in the flags), and the same order.
+  // 3D and 4D; a floor of photons with equal y makes ties.
+  for (bool spaceTime : {false, true}) {
+    photon::PhotonStore alone(0.0f, 1.0f);
+    uint64_t state = 12345;
+    auto next = [&state] {
+      state = state * 6364136223846793005ull + 1442695040888963407ull;
+      return float(uint32_t(state >> 40)) * 0x1p-24f;
+    };
+    for (int i = 0; i < 50000; ++i) {
+      float x = next() * 10.0f, z = next() * 10.0f, y = i % 3 == 0 ? 0.0f : next() * 4.0f;
+      alone.add({x, y, z}, Rgb(1.0f, 0.5f, 0.25f), {0.0f, 1.0f, 0.0f}, next());
+    }
+    photon::PhotonStore together = alone;
+    photon::KdBuildOptions opt;
+    opt.spaceTime = spaceTime;
+    opt.kappa = 3.0f;
+    std::vector<uint32_t> orderAlone, orderTogether;
+    opt.order = &orderAlone;
+    photon::KdTree::build(alone, opt);
+    opt.order = &orderTogether;
+    opt.comm = &comm;
+    photon::KdTree::build(together, opt);
+    auto same = [&](const auto* a, const auto* b) { return std::memcmp(a, b, alone.size() * sizeof(*a)) == 0; };
+    check(orderAlone == orderTogether && same(alone.xs(), together.xs()) && same(alone.ys(), together.ys()) &&
+              same(alone.zs(), together.zs()) && same(alone.flags(), together.flags()),
+          comm, spaceTime ? "4D kd-tree built by the ranks equals the one built alone"
+                          : "3D kd-tree built by the ranks equals the one built alone");
   }
 
   uint64_t failed[1] = {uint64_t(failures)};
