@@ -535,6 +535,7 @@ PhotonStore traceQueuedBatches(const Tracer& tracer, dist::Comm& comm, uint64_t 
       progress(stage, size_t(hi) * kPathsPerBatch, paths);  // the job's progress, roughly
     }
   }
+  progress(stage, paths, paths);  // every chunk taken
   *raysOut = rays;
   // Who traced which chunk, and how many photons each chunk stored.
   std::vector<uint64_t> perRank = comm.allgather(uint64_t(chunks.size()));

@@ -133,6 +133,7 @@ std::vector<size_t> forEachClaimedTile(int width, int height, const std::string&
       progress(stage, size_t(k) + 1, total);
     }
   });
+  progress(stage, total, total);  // every tile taken (the other ranks may still be at their last)
   std::vector<size_t> all;
   for (const std::vector<size_t>& m : taken) all.insert(all.end(), m.begin(), m.end());
   std::sort(all.begin(), all.end());
