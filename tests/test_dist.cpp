@@ -4,9 +4,15 @@
 // detection. The multi-process runs are in tests/test_dist_mpi.cpp.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cstdlib>
+#include <memory>
 #include <string>
+#include <thread>
 #include <vector>
+
+#include <tbb/task_arena.h>
 
 #include "dist/comm.h"
 #include "render/pixel_share.h"
@@ -133,4 +139,48 @@ TEST_CASE("dist: a round of units is combined on rank 0 in unit order (one proce
     CHECK(owners == 1);
     CHECK(dist::ownsUnit(u, int(u % 3), 3));
   }
+}
+
+// The tile queue (forEachClaimedTile): two "ranks", each a thread with its
+// own TBB loop of 2 workers, take tiles from one shared counter, as ranks
+// take them from dist::SharedCounter under MPI. Every tile is rendered
+// exactly once, the returned lists are what each rank rendered, and a rank
+// that stalls (here: each of its workers in its first tile until the other
+// rank is done) keeps only the tiles it had taken: the other does the rest.
+TEST_CASE("dist: the tile queue gives every tile to exactly one taker; a stalled taker leaves the rest to the other") {
+  const int w = 200, h = 130;  // 13 x 9 tiles, ragged edges
+  const size_t total = ownedTiles(w, h, TileShare{}).size();
+  std::unique_ptr<dist::SharedCounter> queue = dist::local().sharedCounter();
+  std::vector<std::atomic<int>> visits(total);
+  std::vector<size_t> lists[2];
+  std::atomic<bool> firstDone{false};
+  auto rank = [&](int r) {
+    tbb::task_arena arena(2);
+    arena.execute([&] {
+      lists[r] = forEachClaimedTile<int>(w, h, "t", Progress{}, [&](const Tile& t, int&) {
+        size_t idx = size_t(t.y0 / kTileSize) * size_t((w + kTileSize - 1) / kTileSize) + size_t(t.x0 / kTileSize);
+        visits[idx].fetch_add(1);
+        if (r == 1)
+          while (!firstDone.load()) std::this_thread::yield();
+      }, [&] { return queue->fetchAdd(1); });
+    });
+  };
+  std::thread a(rank, 0), b(rank, 1);
+  a.join();
+  firstDone = true;
+  b.join();
+  for (size_t i = 0; i < total; ++i) CHECK(visits[i].load() == 1);
+  CHECK(lists[0].size() + lists[1].size() == total);
+  CHECK(std::is_sorted(lists[0].begin(), lists[0].end()));
+  std::vector<size_t> both = lists[0];
+  both.insert(both.end(), lists[1].begin(), lists[1].end());
+  std::sort(both.begin(), both.end());
+  for (size_t i = 0; i < total; ++i) CHECK(both[i] == i);
+  CHECK(lists[1].size() <= 2);  // at most one tile per worker of the stalled rank
+  CHECK(lists[0].size() >= total - 2);
+  // Gathering pixels by these owners on one process is a no-op; the owners'
+  // lists cover the image.
+  TileOwners owners = shareTileOwners(dist::local(), both);
+  REQUIRE(owners.tiles.size() == 1);
+  CHECK(owners.tiles[0].size() == total);
 }

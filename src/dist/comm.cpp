@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -15,6 +16,14 @@
 namespace tdpm::dist {
 
 namespace {
+
+class LocalCounter final : public SharedCounter {
+ public:
+  uint64_t fetchAdd(uint64_t n) override { return value_.fetch_add(n); }
+
+ private:
+  std::atomic<uint64_t> value_{0};
+};
 
 // One process: every collective is a copy (or nothing).
 class LocalComm final : public Comm {
@@ -29,6 +38,7 @@ class LocalComm final : public Comm {
   }
   void broadcast(void*, uint64_t, int) override {}
   void allreduceSum(uint64_t*, size_t) override {}
+  std::unique_ptr<SharedCounter> sharedCounter() override { return std::make_unique<LocalCounter>(); }
   [[noreturn]] void abort(const std::string& message, int code) override {
     std::fprintf(stderr, "%s\n", message.c_str());
     std::fflush(stderr);

@@ -13,6 +13,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,17 @@ struct CommStats {
   // CPU time of the calling thread inside collectives: MPI busy-polls while
   // it waits, so a rank waiting for a slower one burns CPU here.
   double cpuSeconds = 0;
+};
+
+// A counter every rank of the job shares, for handing out work as it is
+// asked for (the tiles of a render: render/tile_loop.h). fetchAdd returns
+// the value before adding `n`, atomically over the whole job; any thread of
+// a rank may call it. Made by Comm::sharedCounter (collective, value 0) and
+// destroyed by every rank at the same point of the program (collective too).
+class SharedCounter {
+ public:
+  virtual ~SharedCounter() = default;
+  virtual uint64_t fetchAdd(uint64_t n) = 0;
 };
 
 class Comm {
@@ -52,6 +64,9 @@ class Comm {
   // rank printed `message` on stderr. For a failure the other ranks cannot
   // know about (they would wait forever in the next collective).
   [[noreturn]] virtual void abort(const std::string& message, int code) = 0;
+  // Collective: a new SharedCounter at 0 (held by rank 0; under MPI a
+  // one-sided window that the other ranks update without rank 0 taking part).
+  virtual std::unique_ptr<SharedCounter> sharedCounter() = 0;
 
   const CommStats& stats() const { return stats_; }
 

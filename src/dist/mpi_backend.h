@@ -7,8 +7,8 @@ namespace tdpm::dist {
 class Comm;
 
 namespace mpi {
-// MPI_Init (MPI_THREAD_FUNNELED: only the thread that runs main talks MPI;
-// TBB workers never do). Returns the world Comm, alive until stop().
+// MPI_Init (MPI_THREAD_SERIALIZED: collectives on the thread that runs
+// main; TBB workers only take tiles from a SharedCounter, behind its mutex). Returns the world Comm, alive until stop().
 Comm* start(int& argc, char**& argv);
 void stop();
 }  // namespace mpi

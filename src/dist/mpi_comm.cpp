@@ -1,6 +1,8 @@
 // dist/mpi_comm.cpp — the Comm of an `mpirun` job, on MPI_COMM_WORLD: the
 // only file of tdpm that includes mpi.h (compiled only with TDPM_MPI).
-// Only the main thread calls MPI (MPI_THREAD_FUNNELED); TBB workers never do.
+// Collectives run on the main thread only; the shared counter of the tile
+// queue is called from TBB workers too, one call at a time behind its mutex
+// (MPI_THREAD_SERIALIZED).
 #include <mpi.h>
 
 #include <algorithm>
@@ -10,6 +12,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <exception>
+#include <mutex>
 
 #include "dist/comm.h"
 #include "dist/mpi_backend.h"
@@ -40,6 +44,49 @@ class Clock {
   CommStats& s_;
   std::chrono::steady_clock::time_point start_;
   double cpu_;
+};
+
+// The counter of a work queue: one uint64 in an MPI window on rank 0, read
+// and incremented by MPI_Fetch_and_op under a passive-target epoch (lock_all
+// for the counter's life), so rank 0 need not serve requests: on one machine
+// Open MPI's osc/sm does the atomic add in shared memory. The mutex makes
+// the calls of a rank's threads one at a time (MPI_THREAD_SERIALIZED).
+class MpiCounter final : public SharedCounter {
+ public:
+  explicit MpiCounter(CommStats& stats) : stats_(stats) {
+    Clock c(stats_);
+    int rank = 0;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Win_allocate(rank == 0 ? MPI_Aint(sizeof(uint64_t)) : 0, sizeof(uint64_t), MPI_INFO_NULL, MPI_COMM_WORLD, &base_,
+                     &win_);
+    if (rank == 0) *base_ = 0;
+    MPI_Barrier(MPI_COMM_WORLD);  // rank 0's zero is in place before anyone adds
+    MPI_Win_lock_all(0, win_);
+  }
+  ~MpiCounter() override {
+    MPI_Win_unlock_all(win_);
+    // MPI_Win_free is collective: when this rank is unwinding an error the
+    // others may never get here, and the job is about to be aborted anyway.
+    if (std::uncaught_exceptions() == 0) {
+      Clock c(stats_);
+      MPI_Win_free(&win_);
+    }
+  }
+  uint64_t fetchAdd(uint64_t n) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Clock c(stats_);
+    uint64_t old = 0;
+    MPI_Fetch_and_op(&n, &old, MPI_UINT64_T, 0, 0, MPI_SUM, win_);
+    MPI_Win_flush(0, win_);
+    stats_.bytesSent += sizeof n;
+    return old;
+  }
+
+ private:
+  CommStats& stats_;
+  std::mutex mutex_;
+  MPI_Win win_ = MPI_WIN_NULL;
+  uint64_t* base_ = nullptr;
 };
 
 class MpiComm final : public Comm {
@@ -109,6 +156,8 @@ class MpiComm final : public Comm {
     }
   }
 
+  std::unique_ptr<SharedCounter> sharedCounter() override { return std::make_unique<MpiCounter>(stats_); }
+
   [[noreturn]] void abort(const std::string& message, int code) override {
     std::fprintf(stderr, "%s\n", message.c_str());
     std::fflush(stderr);
@@ -159,7 +208,7 @@ void preferSharedMemoryOnOneMachine() {
 Comm* start(int& argc, char**& argv) {
   preferSharedMemoryOnOneMachine();
   int provided = 0;
-  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_SERIALIZED, &provided);
   gComm = new MpiComm();
   return gComm;
 }

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "core/error.h"
@@ -503,6 +504,77 @@ void allgatherStore(dist::Comm& comm, PhotonStore& store) {
   store = std::move(all);
 }
 
+// Batches of a distributed fixed-budget render taken from a work queue
+// (dist::SharedCounter): each rank takes chunks of kQueueChunk batches as it
+// gets through them (a rank on a faster core takes more), then every rank
+// receives every chunk's photons and puts them in chunk order, which is
+// batch order: the store one process makes, whoever traced what.
+constexpr uint64_t kQueueChunk = 4;
+
+PhotonStore traceQueuedBatches(const Tracer& tracer, dist::Comm& comm, uint64_t batches, double energyScale,
+                               const Progress& progress, const char* stage, size_t expected, uint64_t* raysOut) {
+  PhotonStore mine(tracer.t0, tracer.t1);
+  mine.reserve(expected);
+  std::vector<uint64_t> chunks, counts;  // this rank's chunk numbers and their photon counts
+  uint64_t rays = 0;
+  const uint64_t chunkCount = (batches + kQueueChunk - 1) / kQueueChunk;
+  const size_t paths = size_t(batches) * kPathsPerBatch;
+  progress(stage, 0, paths);
+  {
+    std::unique_ptr<dist::SharedCounter> queue = comm.sharedCounter();
+    for (;;) {
+      const uint64_t c = queue->fetchAdd(1);  // main thread only: the batches inside run in parallel
+      if (c >= chunkCount) break;
+      const uint64_t lo = c * kQueueChunk, hi = std::min(batches, lo + kQueueChunk);
+      uint64_t r = 0;
+      PhotonStore part = tracer.traceBatches(lo, hi, energyScale, Progress{}, stage, 0, &r);
+      rays += r;
+      chunks.push_back(c);
+      counts.push_back(part.size());
+      mine.appendBatches(&part, 1);
+      progress(stage, size_t(hi) * kPathsPerBatch, paths);  // the job's progress, roughly
+    }
+  }
+  progress(stage, paths, paths);  // every chunk taken
+  *raysOut = rays;
+  // Who traced which chunk, and how many photons each chunk stored.
+  std::vector<uint64_t> perRank = comm.allgather(uint64_t(chunks.size()));
+  std::vector<uint64_t> bytes(perRank.size());
+  uint64_t listed = 0;
+  for (size_t r = 0; r < perRank.size(); ++r) {
+    bytes[r] = perRank[r] * sizeof(uint64_t);
+    listed += perRank[r];
+  }
+  TDPM_ASSERT(listed == chunkCount, "every chunk of photon batches traced once");
+  std::vector<uint64_t> allChunks(static_cast<size_t>(listed)), allCounts(static_cast<size_t>(listed));
+  comm.allgatherv(chunks.data(), allChunks.data(), bytes);
+  comm.allgatherv(counts.data(), allCounts.data(), bytes);
+  allgatherStore(comm, mine);  // rank order
+  // Where chunk c starts in the rank-order store.
+  std::vector<uint64_t> start(static_cast<size_t>(chunkCount)), size(static_cast<size_t>(chunkCount));
+  uint64_t at = 0;
+  for (size_t k = 0; k < allChunks.size(); ++k) {
+    start[size_t(allChunks[k])] = at;
+    size[size_t(allChunks[k])] = allCounts[k];
+    at += allCounts[k];
+  }
+  TDPM_ASSERT(at == mine.size(), "photon counts of the chunks add up to the gathered store");
+  PhotonStore ordered(mine.t0(), mine.t1());
+  PhotonStore::RawArrays a = ordered.resizeForFill(mine.size());
+  size_t to = 0;
+  for (size_t c = 0; c < start.size(); ++c) {
+    const size_t from = size_t(start[c]), n = size_t(size[c]);
+    std::copy_n(mine.xs() + from, n, a.x + to);
+    std::copy_n(mine.ys() + from, n, a.y + to);
+    std::copy_n(mine.zs() + from, n, a.z + to);
+    std::copy_n(mine.energies() + from, n, a.energy + to);
+    std::copy_n(mine.directions() + from, n, a.direction + to);
+    std::copy_n(mine.flags() + from, n, a.flags + to);
+    to += n;
+  }
+  return ordered;
+}
+
 }  // namespace
 
 void photonTimeRange(const Scene& scene, float& t0, float& t1) {
@@ -615,16 +687,17 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   // The final count is Poisson-like around the wanted one: reserve a few
   // standard deviations more so the store rarely needs to grow.
   size_t expected = settings.storedWanted + size_t(4.0 * std::sqrt(double(settings.storedWanted))) + 1024;
-  uint64_t lo = 0, hi = 0;
-  dist::blockRange(batches, comm.rank(), comm.size(), lo, hi);
-  if (comm.distributed()) expected = size_t(double(expected) * double(hi - lo) / double(batches)) + 1024;
   TDPM_ASSERT(!settings.keepExitPoints || !comm.distributed(), "exit points are kept by one process's maps only");
-  result.store = tracer.traceBatches(lo, hi, energyScale, progress, stage, expected, &result.rays,
-                                     settings.keepExitPoints ? &result.exitPoints : nullptr);
-  comm.allreduceSum(&result.rays, 1);
+  if (comm.distributed()) {
+    expected = size_t(double(expected) / double(comm.size())) + 1024;
+    result.store = traceQueuedBatches(tracer, comm, batches, energyScale, progress, stage, expected, &result.rays);
+    comm.allreduceSum(&result.rays, 1);
+  } else {
+    result.store = tracer.traceBatches(0, batches, energyScale, progress, stage, expected, &result.rays,
+                                       settings.keepExitPoints ? &result.exitPoints : nullptr);
+  }
   result.rays += pilotRays;
   result.store.shrinkToFit();
-  allgatherStore(comm, result.store);
   result.seconds = timer.seconds();
   return result;
 }

@@ -89,6 +89,12 @@ struct SamplingPlan {
   // Distributed render: this rank samples only its own tiles, and the
   // half-buffer errors of every pixel are shared between passes.
   dist::Comm* comm = &dist::local();
+  // Which rank renders which tiles, when distributed: empty, the first pass
+  // takes them from a work queue (forEachClaimedTile) and fills this in;
+  // later adaptive passes and accumulation frames keep them, so a pixel's
+  // samples (and its running mean) stay on one rank. Null: the fixed
+  // interleave (TileShare).
+  TileOwners* owners = nullptr;
   float time01Lo = 0.0f, time01Hi = 1.0f;  // animation frames: sample times in this part of the shutter
 };
 
@@ -116,7 +122,7 @@ void samplePass(const Scene& scene, const Integrator& integrator, const Sampling
                 const std::vector<uint8_t>& active, std::vector<PixelAccumulator>& accs, const std::string& stage,
                 const Progress& progress, int width, int height) {
   const Camera& cam = scene.camera;
-  forEachTile<PixelScratch<Integrator>>(width, height, stage, progress, [&](const Tile& t, PixelScratch<Integrator>& s) {
+  auto tileFn = [&](const Tile& t, PixelScratch<Integrator>& s) {
     for (int y = t.y0; y < t.y1; ++y)
       for (int x = t.x0; x < t.x1; ++x) {
         size_t idx = size_t(y) * size_t(width) + size_t(x);
@@ -142,7 +148,22 @@ void samplePass(const Scene& scene, const Integrator& integrator, const Sampling
         }
       }
     integrator.flush(s.state);
-  }, tileShareOf(*plan.comm));
+  };
+  dist::Comm& comm = *plan.comm;
+  if (!comm.distributed() || !plan.owners) {
+    forEachTile<PixelScratch<Integrator>>(width, height, stage, progress, tileFn, tileShareOf(comm));
+  } else if (plan.owners->empty()) {
+    std::vector<size_t> mine;
+    {
+      std::unique_ptr<dist::SharedCounter> queue = comm.sharedCounter();
+      mine = forEachClaimedTile<PixelScratch<Integrator>>(width, height, stage, progress, tileFn,
+                                                          [&] { return queue->fetchAdd(1); });
+    }
+    *plan.owners = shareTileOwners(comm, mine);
+  } else {
+    forEachListedTile<PixelScratch<Integrator>>(width, height, plan.owners->tiles[size_t(comm.rank())], stage,
+                                                progress, tileFn);
+  }
 }
 
 // Adaptive sampling in passes over the whole image: every pixel takes
@@ -184,7 +205,8 @@ void renderPixelsWith(const Scene& scene, const Integrator& integrator, const Sa
     taken += uint32_t(plan.batch);
     if (int(taken) + plan.batch > plan.maxSpp) break;
     for (size_t i = 0; i < n; ++i) err[i] = float(std::min(accs[i].halfError(), double(FLT_MAX)));
-    sharePixels(*plan.comm, w, h, err, true);
+    if (plan.owners) sharePixels(*plan.comm, w, h, err, true, *plan.owners);
+    else sharePixels(*plan.comm, w, h, err, true);
     bool any = false;
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
@@ -428,6 +450,8 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
   // A scene with no motion at all draws no time samples.
   plan.sampleTime = scene.hasMotion;
   plan.comm = &comm;
+  TileOwners owners;  // filled by the first pass (a distributed render's tile queue)
+  plan.owners = &owners;
 
   if (opt.method == "pathtrace") {
     CausticGuide guide = buildCausticGuide(scene, opt, progress);
@@ -481,9 +505,10 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
   }
   if (comm.distributed()) {
     // Rank 0 gathers the film; estimate counts are summed (integers).
-    sharePixels(comm, film.width, film.height, film.color, false);
-    sharePixels(comm, film.width, film.height, film.sampleCount, false);
-    sharePixels(comm, film.width, film.height, film.varianceOfMean, false);
+    if (owners.empty()) owners = staticTileOwners(film.width, film.height, comm.size());
+    sharePixels(comm, film.width, film.height, film.color, false, owners);
+    sharePixels(comm, film.width, film.height, film.sampleCount, false, owners);
+    sharePixels(comm, film.width, film.height, film.varianceOfMean, false, owners);
     uint64_t counts[2] = {st.standardEstimates, st.timeEstimates};
     comm.allreduceSum(counts, 2);
     st.standardEstimates = counts[0];

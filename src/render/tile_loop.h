@@ -4,8 +4,10 @@
 // a per-thread scratch object it may reuse (no allocation per sample, no
 // locks). Progress is reported once per finished tile. Results must depend
 // only on the pixel (seeded per pixel), so they are identical for any
-// thread count and any tile order. A distributed render (dist/) gives each
-// rank the tiles its TileShare owns; the loop then visits only those.
+// thread count and any tile order. A distributed render (dist/) either
+// hands the tiles out as the ranks ask for them (forEachClaimedTile: a
+// queue, which absorbs ranks running at different speeds) or gives each
+// rank the tiles its TileShare owns (a fixed interleave).
 //
 // Tiles are handed out scattered over the image (or the rank's share), not
 // row by row: tile number k is (k * stride) mod total with stride near
@@ -18,6 +20,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -75,10 +78,10 @@ inline Tile tileAt(size_t index, int width, int height) {
   return Tile{tx * kTileSize, ty * kTileSize, std::min(width, (tx + 1) * kTileSize), std::min(height, (ty + 1) * kTileSize)};
 }
 
+// The loop over a given list of tile indices (scattered order, above).
 template <class Scratch, class TileFn>
-void forEachTile(int width, int height, const std::string& stage, const Progress& progress, TileFn&& fn,
-                 const TileShare& share = {}) {
-  const std::vector<size_t> tiles = ownedTiles(width, height, share);
+void forEachListedTile(int width, int height, const std::vector<size_t>& tiles, const std::string& stage,
+                       const Progress& progress, TileFn&& fn) {
   const size_t total = tiles.size();
   const size_t stride = tileOrderStride(total);
   std::atomic<size_t> done{0};
@@ -93,6 +96,48 @@ void forEachTile(int width, int height, const std::string& stage, const Progress
       progress(stage, done.fetch_add(1) + 1, total);
     }
   });
+}
+
+template <class Scratch, class TileFn>
+void forEachTile(int width, int height, const std::string& stage, const Progress& progress, TileFn&& fn,
+                 const TileShare& share = {}) {
+  forEachListedTile<Scratch>(width, height, ownedTiles(width, height, share), stage, progress, fn);
+}
+
+// Tiles handed out as they are asked for (a work queue): every thread of
+// every rank takes the next number k of a counter the ranks share
+// (`claim()`, dist::SharedCounter::fetchAdd(1)) and renders tile k of the
+// scattered order of the whole image, until k passes the last tile. A rank
+// on a faster (or less busy) core takes more tiles. Which rank renders a
+// tile changes nothing in its pixels (they depend on the pixel and the
+// seed), only who holds them: returns the tiles this process rendered,
+// ascending. Progress counts the tiles taken by the whole job.
+template <class Scratch, class TileFn, class Claim>
+std::vector<size_t> forEachClaimedTile(int width, int height, const std::string& stage, const Progress& progress,
+                                       TileFn&& fn, Claim&& claim) {
+  const size_t total = ownedTiles(width, height, TileShare{}).size();
+  const size_t stride = tileOrderStride(total);
+  tbb::enumerable_thread_specific<Scratch> scratch;
+  tbb::enumerable_thread_specific<std::vector<size_t>> taken;
+  progress(stage, 0, total);
+  const int workers = std::max(1, tbb::this_task_arena::max_concurrency());
+  tbb::parallel_for(0, workers, [&](int) {
+    Scratch& s = scratch.local();
+    std::vector<size_t>& mine = taken.local();
+    for (;;) {
+      const uint64_t k = claim();
+      if (k >= total) break;
+      const size_t i = size_t((k * stride) % total);
+      fn(tileAt(i, width, height), s);
+      mine.push_back(i);
+      progress(stage, size_t(k) + 1, total);
+    }
+  });
+  progress(stage, total, total);  // every tile taken (the other ranks may still be at their last)
+  std::vector<size_t> all;
+  for (const std::vector<size_t>& m : taken) all.insert(all.end(), m.begin(), m.end());
+  std::sort(all.begin(), all.end());
+  return all;
 }
 
 }  // namespace tdpm
