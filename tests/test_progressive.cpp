@@ -6,16 +6,15 @@
 // the mean of frozen-time static renders; resuming a state gives the very
 // image of one longer run; any thread count gives the same image.
 #include <doctest/doctest.h>
-#include <tbb/global_control.h>
 
 #include <cmath>
-#include <cstring>
 #include <vector>
 
 #include "photon/tracer.h"
 #include "render/progressive.h"
 #include "render/renderer.h"
 #include "moving_plane.h"
+#include "progressive_checks.h"
 #include "scene_fixtures.h"
 
 using namespace tdpm;
@@ -89,19 +88,6 @@ std::vector<Error> convergence(const Scene& s, RenderOptions o, const std::vecto
   return out;
 }
 
-bool sameState(const ProgressiveState& a, const ProgressiveState& b) {
-  // Everything but the wall-clock seconds.
-  auto sa = a.scalars, sb = b.scalars;
-  sa.erase("seconds");
-  sb.erase("seconds");
-  if (a.passesDone != b.passesDone || sa != sb || a.layers.size() != b.layers.size()) return false;
-  for (const auto& [name, l] : a.layers) {
-    auto it = b.layers.find(name);
-    if (it == b.layers.end() || it->second.size() != l.size()) return false;
-    if (std::memcmp(l.data(), it->second.data(), l.size() * sizeof(float)) != 0) return false;
-  }
-  return true;
-}
 
 }  // namespace
 
@@ -129,24 +115,9 @@ TEST_CASE("progressive: N passes continued for N more equal 2N passes in one run
     RenderOptions o = planeOptions(method, 3);
     o.visualizeGlobal = false;  // direct light, final gather and both maps
     o.causticPhotons = 1000;
-    o.passes = 4;
-    ProgressiveState whole;
     RenderStats st;
-    renderProgressive(*s, o, whole, Progress{}, st);
+    ProgressiveState whole = test::checkResumeAndThreads(*s, o, st);
     CHECK(whole.passesDone == 4);
-    ProgressiveState half;
-    o.passes = 2;
-    renderProgressive(*s, o, half, Progress{}, st);
-    ProgressiveState copy = half;  // as if written and read back
-    o.passes = 4;
-    renderProgressive(*s, o, copy, Progress{}, st);
-    CHECK(sameState(whole, copy));
-    {
-      tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-      ProgressiveState serial;
-      renderProgressive(*s, o, serial, Progress{}, st);
-      CHECK(sameState(whole, serial));
-    }
   }
 }
 

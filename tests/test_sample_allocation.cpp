@@ -4,11 +4,9 @@
 // samples everywhere (unbiased), the real counts in the film, and the
 // determinism guarantees (threads, N + N resumed == 2N).
 #include <doctest/doctest.h>
-#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <numeric>
 #include <vector>
 
@@ -16,6 +14,7 @@
 #include "render/renderer.h"
 #include "render/sample_allocation.h"
 #include "moving_plane.h"
+#include "progressive_checks.h"
 #include "scene_fixtures.h"
 
 using namespace tdpm;
@@ -62,15 +61,6 @@ RenderOptions glassOptions(float extra) {
   return o;
 }
 
-bool sameLayers(const ProgressiveState& a, const ProgressiveState& b) {
-  if (a.passesDone != b.passesDone || a.layers.size() != b.layers.size()) return false;
-  for (const auto& [name, l] : a.layers) {
-    auto it = b.layers.find(name);
-    if (it == b.layers.end() || it->second.size() != l.size()) return false;
-    if (std::memcmp(l.data(), it->second.data(), l.size() * sizeof(float)) != 0) return false;
-  }
-  return true;
-}
 
 }  // namespace
 
@@ -253,28 +243,14 @@ TEST_CASE("sample allocation: N passes continued for N more equal 2N, for 1 and 
     CAPTURE(samplerName(kind));
     RenderOptions o = glassOptions(0.5f);
     o.sampler = kind;
-    o.passes = 4;
-    ProgressiveState whole;
     RenderStats st;
-    renderProgressive(*s, o, whole, Progress{}, st);
+    ProgressiveState whole = test::checkResumeAndThreads(*s, o, st);  // resume recomputes the map
     CHECK(st.maxSpp > 4 * o.spp);  // the map is in use
-    ProgressiveState half;
-    o.passes = 2;
-    renderProgressive(*s, o, half, Progress{}, st);
-    ProgressiveState copy = half;  // as if written and read back: the map is recomputed
-    o.passes = 4;
-    renderProgressive(*s, o, copy, Progress{}, st);
-    CHECK(sameLayers(whole, copy));
-    {
-      tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-      ProgressiveState serial;
-      renderProgressive(*s, o, serial, Progress{}, st);
-      CHECK(sameLayers(whole, serial));
-    }
     // The map changes the image (the check can fail).
     ProgressiveState plain;
+    o.passes = 4;
     o.passExtraSamples = 0;
     renderProgressive(*s, o, plain, Progress{}, st);
-    CHECK_FALSE(sameLayers(whole, plain));
+    CHECK_FALSE(test::sameState(whole, plain));
   }
 }
