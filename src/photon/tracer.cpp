@@ -70,9 +70,9 @@ struct LightTable {
 };
 
 // ---- projection maps (Jensen 2001, sec. 5.3), as bounding spheres ----
-// A caustic path's first hit must be a specular (delta-only) surface, so
-// the caustic map only needs photons emitted toward the swept bounding
-// spheres of specular objects. Directions (or, for a sun, points on the
+// A caustic path's first hit must be a specular surface (delta-only, or a
+// sharp metal: Material::isCausticBounce), so the caustic map only needs
+// photons emitted toward the swept bounding spheres of those objects. Directions (or, for a sun, points on the
 // emission disc) are drawn from a mixture over those targets; the flux is
 // divided by the mixture density (the number of targets covering the
 // sample over their total measure), so energies stay exact however the
@@ -100,10 +100,10 @@ Bounds3f boundsOver(const SceneObject& o, float u0, float u1) {
 // Targets over the paths' times [u0, u1] (normalised): a segment of an
 // animation's timeline aims at where the objects are then, not at the
 // whole timeline's sweep.
-std::vector<Target> specularTargets(const Scene& scene, float u0 = 0.0f, float u1 = 1.0f) {
+std::vector<Target> specularTargets(const Scene& scene, bool glossy, float u0 = 0.0f, float u1 = 1.0f) {
   std::vector<Target> t;
   for (const SceneObject& o : scene.objects)
-    if (scene.materials[o.material].isDeltaOnly()) {
+    if (glossy ? scene.materials[o.material].isCausticBounce() : scene.materials[o.material].isDeltaOnly()) {
       Bounds3f b = boundsOver(o, u0, u1);
       t.push_back({b.center(), 0.5f * length(b.diagonal()) * 1.001f});
     }
@@ -418,6 +418,9 @@ struct Tracer {
       if (!scene.intersect(origin, dir, std::numeric_limits<float>::infinity(), time01, hit)) return rays;
       if (hit.isLight()) return rays;  // emitters absorb
       const Material& mat = scene.materials[scene.objects[hit.object].material];
+      // A sharp metal continues a caustic path (after storing there: the
+      // caustic seen on the metal itself is L S+ G).
+      bool glossyBounce = settings.glossyCaustics && mat.isGlossy();
       if (!mat.isDeltaOnly()) {
         bool store = settings.kind == MapKind::Global || (bounce > 0 && allSpecular);
         // The side it arrived on keeps it out of estimates on the other side
@@ -426,15 +429,16 @@ struct Tracer {
           out.add(hit.p, power * float(energyScale), -dir, time, surfaceTag(hit.object, dot(hit.n, dir) > 0.0f));
           if (exits) exits->push_back(lastSpecular);
         }
-        if (settings.kind == MapKind::Caustic) return rays;  // L S+ D ends here
+        if (settings.kind == MapKind::Caustic && !glossyBounce) return rays;  // L (S|G)+ D ends here
       }
       ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
       BsdfSample bs;
       Vec3f ub = rng.get3D(dims::vertexGroup(bounce, dims::kBsdf));
       if (!bsdfSample(ctx, {ub.x, ub.y}, ub.z, Transport::Importance, bs)) return rays;
-      if (settings.kind == MapKind::Caustic && !bs.delta) return rays;
-      allSpecular = allSpecular && bs.delta;
-      if (bs.delta) lastSpecular = hit.p;
+      bool specularLike = bs.delta || glossyBounce;
+      if (settings.kind == MapKind::Caustic && !specularLike) return rays;
+      allSpecular = allSpecular && specularLike;
+      if (specularLike) lastSpecular = hit.p;
       // Russian roulette by the scattering's throughput: surviving photons
       // keep (on average) their power instead of dimming.
       float survive = std::min(1.0f, bs.weight.maxComponent());
@@ -582,9 +586,10 @@ void photonTimeRange(const Scene& scene, float& t0, float& t1) {
   t1 = scene.shutter.instant() ? scene.shutter.open + 1.0f : scene.shutter.close;
 }
 
-bool sceneHasSpecular(const Scene& scene) {
+bool sceneHasSpecular(const Scene& scene, bool glossy) {
   for (const SceneObject& o : scene.objects)
-    if (scene.materials[o.material].isDeltaOnly()) return true;
+    if (glossy ? scene.materials[o.material].isCausticBounce() : scene.materials[o.material].isDeltaOnly())
+      return true;
   return false;
 }
 
@@ -607,7 +612,7 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   }
   result.store = PhotonStore(t0, t1);
   std::vector<Target> targets;
-  if (settings.kind == MapKind::Caustic) targets = specularTargets(scene, u0, u1);
+  if (settings.kind == MapKind::Caustic) targets = specularTargets(scene, settings.glossyCaustics, u0, u1);
   Tracer tracer{scene, settings, targets,
                 makeLightTable(scene, settings.kind == MapKind::Caustic && settings.projection ? &targets : nullptr,
                                settings.areaLightsOnly),
@@ -615,7 +620,7 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
                 t1, ts,
                 uint32_t(mix64(settings.seed ^ 0x7173ull)), u0, u1};
   if (settings.storedWanted == 0 || tracer.lights.empty()) return result;
-  if (settings.kind == MapKind::Caustic && !sceneHasSpecular(scene)) return result;
+  if (settings.kind == MapKind::Caustic && !sceneHasSpecular(scene, settings.glossyCaustics)) return result;
   const char* stage = settings.kind == MapKind::Caustic ? "caustic photons" : "global photons";
   if (settings.paths > 0) {
     // A progressive pass: the count is fixed (pass 0's pilot chose it).

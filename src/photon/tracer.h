@@ -65,6 +65,11 @@ struct TraceSettings {
   // TraceResult::exitPoints (one process only, not under MPI).
   bool areaLightsOnly = false;
   bool keepExitPoints = false;
+  // Caustic map: sharp metals (Material::isGlossy) bounce caustic paths
+  // like mirrors, so L (S|G)+ D is stored (photons are aimed at them too);
+  // false: L S+ D with delta surfaces only (the path tracer's guide, whose
+  // cones aim at the last delta exit point).
+  bool glossyCaustics = true;
 };
 
 // Paths per batch: the unit of emission counts and of TraceSettings::firstPath.
@@ -91,6 +96,7 @@ void photonTimeRange(const Scene& scene, float& t0, float& t1);
 TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, const Progress& progress);
 
 // Whether any path could contribute to a caustic map (a delta-only surface).
-bool sceneHasSpecular(const Scene& scene);
+// Has a caustic generator: a mirror or glass, or (glossy) a sharp metal.
+bool sceneHasSpecular(const Scene& scene, bool glossy = true);
 
 }  // namespace tdpm::photon

@@ -35,7 +35,7 @@ bool diffuseLike(const Material& m) {
 
 CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings& s, const Progress& progress) {
   CausticGuide g;
-  if (!(s.fraction > 0.0f) || s.photons == 0 || !photon::sceneHasSpecular(scene)) return g;
+  if (!(s.fraction > 0.0f) || s.photons == 0 || !photon::sceneHasSpecular(scene, false)) return g;
   photon::TraceSettings t;
   t.kind = photon::MapKind::Caustic;
   t.storedWanted = s.photons;
@@ -43,6 +43,7 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
   t.sampler = s.sampler;
   t.areaLightsOnly = true;
   t.keepExitPoints = true;
+  t.glossyCaustics = false;  // cones aim at delta exit points only
   t.comm = &dist::local();  // every rank traces the same guide itself
   photon::TraceResult traced = photon::tracePhotons(scene, t, progress);
   if (traced.store.size() < size_t(kNeighbours) || traced.exitPoints.size() != traced.store.size()) return g;

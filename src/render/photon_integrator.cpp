@@ -12,7 +12,7 @@
 namespace tdpm {
 
 namespace {
-constexpr int kGatherSpecularBounces = 4;  // a gather ray may pass this many mirrors/glass
+constexpr int kGatherSpecularBounces = 4;  // a gather ray may pass this many mirrors/glass/sharp metals
 constexpr float kInf = std::numeric_limits<float>::infinity();
 }  // namespace
 
@@ -108,7 +108,11 @@ Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, flo
       }
       const Material& m = scene_.materials[scene_.objects[h.object].material];
       ShadingContext c = makeShadingContext(m, m.albedo.at(h.localP), h.n, -d);
-      if (!m.isDeltaOnly()) {
+      // Through mirrors, glass and sharp metals to the first diffuse-like
+      // surface: light a sharp metal reflects toward the gather point is in
+      // the caustic map (L (S|G)+ D, Material::isGlossy), and light reaching
+      // the metal from other surfaces is estimated where it comes from.
+      if (!m.isCausticBounce()) {
         sum += beta * estimate(global_, ts.global, ts.global3, h, c, -d, time01, s_.timeDependent && moved, ts);
         break;
       }

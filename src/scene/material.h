@@ -37,6 +37,18 @@ struct Material {
 
   // Purely delta (mirror, glass): no photon is stored here, no light sampling.
   bool isDeltaOnly() const { return type == Type::Mirror || type == Type::Dielectric; }
+  // A sharp metal (GGX alpha <= kGlossyAlpha): photons treat it like a
+  // mirror for the caustic map (L (S|G)+ D paths), and final-gather rays
+  // pass through it to the next diffuse surface instead of estimating there.
+  // Why: the light such a surface reflects onto a floor is a blurred caustic
+  // that a cosine-sampled gather ray finds only when it happens to hit the
+  // lamp's highlight, and then at ~100x the floor's mean (the dots beside
+  // the steel post of scenes/glass-ball.json); as photons it is a smooth
+  // density. Rougher metal and plastic stay diffuse-like gather surfaces.
+  static constexpr float kGlossyAlpha = 0.2f;
+  bool isGlossy() const { return type == Type::Metal && alpha <= kGlossyAlpha; }
+  // Caustic generators: what caustic photons are aimed at and bounce on.
+  bool isCausticBounce() const { return isDeltaOnly() || isGlossy(); }
   bool transmits() const { return type == Type::Dielectric; }
 };
 
