@@ -14,6 +14,7 @@ namespace tdpm {
 namespace {
 constexpr int kGatherSpecularBounces = 4;  // a gather ray may pass this many mirrors/glass/sharp metals
 constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr int kSplitGlassVertices = 2;  // traceFrom
 }  // namespace
 
 PhotonIntegrator::PhotonIntegrator(const Scene& scene, const PhotonMap* caustic, const PhotonMap* global,
@@ -149,13 +150,30 @@ Rgb PhotonIntegrator::eyePart(Vec3f origin, Vec3f dir, float time01, Stream& sam
 // prefix of All's: the same path and shadow rays for the same stream).
 template <PhotonIntegrator::Part kPart, class Stream>
 Rgb PhotonIntegrator::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts, Rgb* eye) const {
-  Rgb L(0.0f), beta(1.0f);
+  EyeVertex v;
   // A moving camera sees a different surface point at each time: never
   // the fixed-point time average, so always the time-dependent estimate.
-  bool touched = scene_.camera.moving();
-  bool lastDelta = true;
-  float pathLength = 0.0f;  // from the camera, through mirrors and glass: the pixel footprint grows with it
-  for (int depth = 0; depth < s_.maxDepth; ++depth) {
+  v.touched = scene_.camera.moving();
+  return traceFrom<kPart>(origin, dir, time01, v, sampler, ts, eye);
+}
+
+// From `v` on (the camera, or one branch of a split glass vertex). At the
+// path's first kSplitGlassVertices glass surfaces both branches are
+// followed, weighted by Fresnel, instead of choosing one with probability
+// F: a highlight reflected on or inside a moving glass ball (F ~ 4%) is
+// then found by every sample whose time puts it in the pixel, not by one in
+// 25 of them (the grainy streaks on scenes/glass-ball.json's ball). Two
+// vertices: the outer reflection and the inner one; a path splits into at
+// most 4. Later glass vertices choose.
+template <PhotonIntegrator::Part kPart, class Stream>
+Rgb PhotonIntegrator::traceFrom(Vec3f origin, Vec3f dir, float time01, EyeVertex v, Stream& sampler,
+                                ThreadState& ts, Rgb* eye) const {
+  Rgb L(0.0f), branchL(0.0f), branchEye(0.0f);
+  Rgb beta = v.beta;
+  bool touched = v.touched;
+  float pathLength = v.pathLength;  // from the camera, through mirrors and glass: the pixel footprint grows with it
+  int splits = v.splits;
+  for (int depth = v.depth; depth < s_.maxDepth; ++depth) {
     Hit hit;
     if (!scene_.intersect(origin, dir, kInf, time01, hit)) {
       L += beta * scene_.background;
@@ -165,11 +183,10 @@ Rgb PhotonIntegrator::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampl
     pathLength += hit.t;
     touched = touched || scene_.segmentMeetsMotion(origin, dir, hit.t);
     if (hit.isLight()) {
-      // Seen directly or through mirrors/glass only: shadow rays cannot.
-      if (lastDelta) {
-        const Light& light = scene_.lights[size_t(hit.light)];
-        L += beta * areaLightRadiance(light, areaLightFrame(light, time01), -dir);
-      }
+      // Seen directly or through mirrors/glass only (every vertex before a
+      // gather point is delta): shadow rays cannot.
+      const Light& light = scene_.lights[size_t(hit.light)];
+      L += beta * areaLightRadiance(light, areaLightFrame(light, time01), -dir);
       if constexpr (kPart == Part::Split) *eye = L;
       break;
     }
@@ -195,17 +212,35 @@ Rgb PhotonIntegrator::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampl
       break;
     }
 
-    // ---- mirror / glass: follow one branch ----
+    // ---- mirror / glass ----
     BsdfSample bs;
-    Vec3f u = sampler.get3D(dims::vertexGroup(depth, dims::kBsdf));
-    if (!bsdfSample(ctx, {u.x, u.y}, u.z, Transport::Radiance, bs)) break;
+    if (splits < kSplitGlassVertices && mat.transmits()) {
+      ++splits;
+      BsdfSample reflected;
+      float F = dielectricBranches(ctx, Transport::Radiance, reflected, bs);
+      if (F < 1.0f) {
+        // The reflected branch as its own path (weight F x its chosen
+        // weight); this loop goes on with the refracted one, x (1 - F).
+        EyeVertex r{beta * reflected.weight * F, touched, pathLength, depth + 1, splits};
+        if (!r.beta.isBlack() && isFinite(r.beta)) {
+          Rgb eyeR(0.0f);
+          branchL += traceFrom<kPart>(scene_.spawnOrigin(hit.p, hit.n, reflected.wi), reflected.wi, time01, r,
+                                     sampler, ts, kPart == Part::Split ? &eyeR : nullptr);
+          branchEye += eyeR;
+        }
+        bs.weight = bs.weight * (1.0f - F);
+      }
+    } else {
+      Vec3f u = sampler.get3D(dims::vertexGroup(depth, dims::kBsdf));
+      if (!bsdfSample(ctx, {u.x, u.y}, u.z, Transport::Radiance, bs)) break;
+    }
     beta *= bs.weight;
     if (beta.isBlack() || !isFinite(beta)) break;
-    lastDelta = true;
     origin = scene_.spawnOrigin(hit.p, hit.n, bs.wi);
     dir = bs.wi;
   }
-  return L;
+  if constexpr (kPart == Part::Split) *eye += branchEye;
+  return L + branchL;
 }
 
 template Rgb PhotonIntegrator::radiance<RandomStream>(Vec3f, Vec3f, float, RandomStream&, ThreadState&) const;

@@ -1,6 +1,7 @@
 // render/photon_integrator.h — eye paths for the four photon-map methods.
-// An eye path at time t follows mirrors and glass (one branch chosen by
-// Fresnel) to the first non-delta surface, the gather point, and there adds
+// An eye path at time t follows mirrors and glass (at its first two glass
+// surfaces both branches, weighted by Fresnel; later one, chosen by Fresnel)
+// to the first non-delta surface, the gather point, and there adds
 //   direct light (shadow rays at t) + caustics (caustic map) +
 //   indirect light (final gather: BSDF-sampled rays whose first non-delta
 //   hit is estimated from the global map).
@@ -87,8 +88,21 @@ class PhotonIntegrator {
                const Hit& hit, const struct ShadingContext& ctx, Vec3f wo, float time01, bool timeDependent,
                ThreadState& ts, float minVolume = 0.0f) const;
   enum class Part { All, Split, EyeOnly };
+  // Where an eye path (or one branch of it) starts: its throughput, whether
+  // it has met motion, its length so far, its depth, and how many glass
+  // vertices were split before it (traceFrom).
+  struct EyeVertex {
+    Rgb beta{1.0f};
+    bool touched = false;
+    float pathLength = 0.0f;
+    int depth = 0;
+    int splits = 0;  // glass vertices split so far
+  };
   template <Part kPart, class Stream>
   Rgb trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts, Rgb* eye) const;
+  template <Part kPart, class Stream>
+  Rgb traceFrom(Vec3f origin, Vec3f dir, float time01, EyeVertex v, Stream& sampler, ThreadState& ts,
+                Rgb* eye) const;
   template <class Stream>
   Rgb finalGather(const Hit& hit, const struct ShadingContext& ctx, float time01, bool touched, Stream& sampler,
                   int vertex, ThreadState& ts) const;

@@ -111,6 +111,18 @@ float bsdfPdf(const ShadingContext& c, Vec3f wiWorld) {
   }
 }
 
+float dielectricBranches(const ShadingContext& c, Transport mode, BsdfSample& reflected, BsdfSample& refracted) {
+  // Reuses bsdfSample's two lobes: uLobe 0 always reflects, and just
+  // below 1 refracts unless total internal reflection (F = 1) forbids it.
+  const Material& m = *c.material;
+  Vec3f wo = c.woLocal;
+  float eta = wo.z > 0 ? m.ior : 1.0f / m.ior;
+  float F = fresnelDielectric(std::fabs(wo.z), eta);
+  bsdfSample(c, {0, 0}, 0.0f, mode, reflected);
+  bsdfSample(c, {0, 0}, std::nextafter(1.0f, 0.0f), mode, refracted);
+  return F;
+}
+
 bool bsdfSample(const ShadingContext& c, Vec2f u, float uLobe, Transport mode, BsdfSample& out) {
   const Material& m = *c.material;
   Vec3f wo = c.woLocal;

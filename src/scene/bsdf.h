@@ -41,6 +41,13 @@ float bsdfPdf(const ShadingContext& c, Vec3f wiWorld);
 // u: 2D sample; uLobe: lobe choice. Returns false if the path ends.
 bool bsdfSample(const ShadingContext& c, Vec2f u, float uLobe, Transport mode, BsdfSample& out);
 
+// A dielectric's two delta branches at once (for splitting instead of the
+// Fresnel choice): the reflected and refracted directions, each with the
+// weight bsdfSample gives it when chosen, and the Fresnel reflectance F, the
+// probability bsdfSample chooses reflection. F = 1 under total internal
+// reflection (then `refracted` is the reflection too).
+float dielectricBranches(const ShadingContext& c, Transport mode, BsdfSample& reflected, BsdfSample& refracted);
+
 // Unpolarised Fresnel reflectance of a dielectric interface; cosI is the
 // cosine on the incident side, eta = eta_transmitted / eta_incident.
 float fresnelDielectric(float cosI, float eta);
