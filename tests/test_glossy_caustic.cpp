@@ -105,3 +105,43 @@ TEST_CASE("glossy caustics: the photon methods match the path tracer on a ceilin
   CHECK(standard / ref == doctest::Approx(1.0).epsilon(0.05));
   CHECK(time / ref == doctest::Approx(1.0).epsilon(0.05));
 }
+
+TEST_CASE("glossy caustics: the eye path passes through a sharp metal and matches the path tracer on what it reflects") {
+  // The camera looks down at the metal floor: it reflects the lamp (direct
+  // light by shadow rays and BSDF rays, MIS) and the ceiling, itself lit by
+  // the metal (L G D G E: a caustic seen through the metal).
+  auto d = metalFloorUnderCeiling();
+  d.camera.position = {0, 1.2f, 3.0f};
+  d.camera.target = {0, 0, 0};
+  d.camera.fovDegrees = 50;
+  auto s = Scene::build(d);
+  const int w = s->camera.width(), h = s->camera.height();
+  std::vector<size_t> metal;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      Vec3f o, dir;
+      s->camera.generateRay({x + 0.5f, y + 0.5f}, 0.5f, o, dir);
+      Hit hit;
+      if (s->intersect(o, dir, 1e30f, 0.5f, hit) && hit.object == kMetalFloor) metal.push_back(size_t(y) * w + x);
+    }
+  REQUIRE(metal.size() > 200);
+  auto mean = [&](const std::string& method, int spp) {
+    RenderOptions o;
+    o.method = method;
+    o.spp = spp;
+    o.seed = 7;
+    o.causticPhotons = 200000;
+    o.globalPhotons = 20000;
+    o.estimate.k = 100;
+    RenderStats st;
+    Film f = render(*s, o, Progress{}, st);
+    double sum = 0;
+    for (size_t i : metal) sum += f.color[i].average();
+    return sum / double(metal.size());
+  };
+  double ref = mean("pathtrace", 512);
+  double standard = mean("standard", 32);
+  MESSAGE("metal floor mean: pathtrace " << ref << ", standard " << standard << " (" << standard / ref << ")");
+  REQUIRE(ref > 0.05);
+  CHECK(standard / ref == doctest::Approx(1.0).epsilon(0.05));
+}

@@ -165,54 +165,92 @@ Rgb PhotonIntegrator::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampl
 // 25 of them (the grainy streaks on scenes/glass-ball.json's ball). Two
 // vertices: the outer reflection and the inner one; a path splits into at
 // most 4. Later glass vertices choose.
+//
+// A sharp metal (Material::isGlossy) is not a gather point: it adds its
+// direct light (shadow rays, MIS with its BSDF ray hitting a lamp) and its
+// caustics (the caustic map holds L (S|G)+ G), and the path goes on along
+// one BSDF-sampled ray to what the metal reflects, which is estimated there
+// (its direct light by shadow rays, not the global map's density: the
+// steel post of scenes/glass-ball.json reflected the floor grainy). Light
+// reached from the metal through mirrors or glass is a caustic on the
+// metal, already counted, so it is not added again.
 template <PhotonIntegrator::Part kPart, class Stream>
 Rgb PhotonIntegrator::traceFrom(Vec3f origin, Vec3f dir, float time01, EyeVertex v, Stream& sampler,
                                 ThreadState& ts, Rgb* eye) const {
-  Rgb L(0.0f), branchL(0.0f), branchEye(0.0f);
+  // L: the sample; eyeL: its eye part (emission, background and direct
+  // light; radianceSplit), which EyeOnly computes alone.
+  Rgb L(0.0f), eyeL(0.0f), branchL(0.0f), branchEye(0.0f);
+  auto addEye = [&](Rgb c) {
+    L += c;
+    eyeL += c;
+  };
   Rgb beta = v.beta;
   bool touched = v.touched;
   float pathLength = v.pathLength;  // from the camera, through mirrors and glass: the pixel footprint grows with it
   int splits = v.splits;
+  bool emissionCounts = v.emissionCounts;
+  float metalPdf = 0.0f;  // > 0: this ray left a sharp metal with this BSDF density (MIS of a lamp it hits)
+  Vec3f metalP;
   for (int depth = v.depth; depth < s_.maxDepth; ++depth) {
     Hit hit;
     if (!scene_.intersect(origin, dir, kInf, time01, hit)) {
-      L += beta * scene_.background;
-      if constexpr (kPart == Part::Split) *eye = L;
+      addEye(beta * scene_.background);
       break;
     }
     pathLength += hit.t;
     touched = touched || scene_.segmentMeetsMotion(origin, dir, hit.t);
     if (hit.isLight()) {
-      // Seen directly or through mirrors/glass only (every vertex before a
-      // gather point is delta): shadow rays cannot.
-      const Light& light = scene_.lights[size_t(hit.light)];
-      L += beta * areaLightRadiance(light, areaLightFrame(light, time01), -dir);
-      if constexpr (kPart == Part::Split) *eye = L;
+      // Seen through mirrors/glass only, or straight from a sharp metal:
+      // shadow rays cannot (or, from the metal, share it by MIS).
+      if (emissionCounts) {
+        const Light& light = scene_.lights[size_t(hit.light)];
+        AreaLightFrame f = areaLightFrame(light, time01);
+        float w = metalPdf > 0.0f ? emissionWeight(metalPdf, areaLightPdf(light, f, metalP, hit.p), 1) : 1.0f;
+        addEye(beta * areaLightRadiance(light, f, -dir) * w);
+      }
       break;
     }
     const Material& mat = scene_.materials[scene_.objects[hit.object].material];
     ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
     bool timeDependent = s_.timeDependent && touched;
+    float minVolume = s_.footprintVolume * pathLength * pathLength;
+
+    if (mat.isGlossy() && !s_.visualizeGlobal) {
+      // ---- sharp metal: direct light and caustics here, then onward ----
+      addEye(beta * directLight(scene_, hit, ctx, time01, sampler, depth, 1));
+      if constexpr (kPart != Part::EyeOnly)
+        L += beta * estimate(caustic_, ts.caustic, ts.caustic3, hit, ctx, -dir, time01, timeDependent, ts, minVolume);
+      BsdfSample bs;
+      Vec3f u = sampler.get3D(dims::vertexGroup(depth, dims::kBsdf));
+      if (!bsdfSample(ctx, {u.x, u.y}, u.z, Transport::Radiance, bs) || !(bs.pdf > 0.0f)) break;
+      beta *= bs.weight;
+      if (beta.isBlack() || !isFinite(beta)) break;
+      emissionCounts = true;
+      metalPdf = bs.pdf;
+      metalP = hit.p;
+      origin = scene_.spawnOrigin(hit.p, hit.n, bs.wi);
+      dir = bs.wi;
+      continue;
+    }
 
     if (!mat.isDeltaOnly()) {
       // ---- gather point ----
       if (s_.visualizeGlobal) {
-        if constexpr (kPart == Part::Split) *eye = L;
         if constexpr (kPart != Part::EyeOnly)
           L += beta * estimate(global_, ts.global, ts.global3, hit, ctx, -dir, time01, timeDependent, ts);
         break;
       }
       bool gather = global_ && global_->size() > 0 && s_.gatherRays > 0;
-      L += beta * directLight(scene_, hit, ctx, time01, sampler, depth, gather ? s_.gatherRays : 0);
-      if constexpr (kPart == Part::Split) *eye = L;
+      addEye(beta * directLight(scene_, hit, ctx, time01, sampler, depth, gather ? s_.gatherRays : 0));
       if constexpr (kPart == Part::EyeOnly) break;
-      L += beta * estimate(caustic_, ts.caustic, ts.caustic3, hit, ctx, -dir, time01, timeDependent, ts,
-                           s_.footprintVolume * pathLength * pathLength);
+      L += beta * estimate(caustic_, ts.caustic, ts.caustic3, hit, ctx, -dir, time01, timeDependent, ts, minVolume);
       if (gather) L += beta * finalGather(hit, ctx, time01, touched, sampler, depth, ts);
       break;
     }
 
     // ---- mirror / glass ----
+    if (metalPdf > 0.0f) emissionCounts = false;  // a lamp from here on is a caustic on the metal
+    metalPdf = 0.0f;
     BsdfSample bs;
     if (splits < kSplitGlassVertices && mat.transmits()) {
       ++splits;
@@ -221,11 +259,11 @@ Rgb PhotonIntegrator::traceFrom(Vec3f origin, Vec3f dir, float time01, EyeVertex
       if (F < 1.0f) {
         // The reflected branch as its own path (weight F x its chosen
         // weight); this loop goes on with the refracted one, x (1 - F).
-        EyeVertex r{beta * reflected.weight * F, touched, pathLength, depth + 1, splits};
+        EyeVertex r{beta * reflected.weight * F, touched, pathLength, depth + 1, splits, emissionCounts};
         if (!r.beta.isBlack() && isFinite(r.beta)) {
           Rgb eyeR(0.0f);
           branchL += traceFrom<kPart>(scene_.spawnOrigin(hit.p, hit.n, reflected.wi), reflected.wi, time01, r,
-                                     sampler, ts, kPart == Part::Split ? &eyeR : nullptr);
+                                      sampler, ts, kPart == Part::Split ? &eyeR : nullptr);
           branchEye += eyeR;
         }
         bs.weight = bs.weight * (1.0f - F);
@@ -239,7 +277,7 @@ Rgb PhotonIntegrator::traceFrom(Vec3f origin, Vec3f dir, float time01, EyeVertex
     origin = scene_.spawnOrigin(hit.p, hit.n, bs.wi);
     dir = bs.wi;
   }
-  if constexpr (kPart == Part::Split) *eye += branchEye;
+  if constexpr (kPart == Part::Split) *eye = eyeL + branchEye;
   return L + branchL;
 }
 

@@ -1,7 +1,8 @@
 // render/photon_integrator.h — eye paths for the four photon-map methods.
 // An eye path at time t follows mirrors and glass (at its first two glass
 // surfaces both branches, weighted by Fresnel; later one, chosen by Fresnel)
-// to the first non-delta surface, the gather point, and there adds
+// and sharp metals (adding their direct light and caustics, then one BSDF
+// ray on) to the first diffuse-like surface, the gather point, and there adds
 //   direct light (shadow rays at t) + caustics (caustic map) +
 //   indirect light (final gather: BSDF-sampled rays whose first non-delta
 //   hit is estimated from the global map).
@@ -97,6 +98,7 @@ class PhotonIntegrator {
     float pathLength = 0.0f;
     int depth = 0;
     int splits = 0;  // glass vertices split so far
+    bool emissionCounts = true;  // false once a sharp metal was followed by mirrors/glass
   };
   template <Part kPart, class Stream>
   Rgb trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts, Rgb* eye) const;
