@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "core/rng.h"
+#include "render/guide_occupancy.h"
 #include "render/guided_sampling.h"
 #include "render/renderer.h"
 #include "scene/parse.h"
@@ -102,6 +103,72 @@ TEST_CASE("caustic guide: the mixture samples by the density it reports, and est
   CHECK(densityMismatch == 0);
   CHECK(inOwnCone == guided);
   CHECK(std::fabs(sum / n - 0.5) < 0.005);  // ~5 standard errors
+}
+
+TEST_CASE("caustic guide: a cleared occupancy bit means fewer than m points within the radius, exactly") {
+  // Points as a guide's photons lie: a dense disc on a floor, a sparse
+  // scatter over a wall, and a few far away. Queries: random points in the
+  // box around them, and points just inside the radius of a point (the
+  // rim, where rounding decides). Wherever the grid says "no", counting
+  // the points strictly within r, with the k-NN's own float arithmetic,
+  // must find fewer than m; and the grid must say "no" for most of the
+  // empty space, or it saves nothing.
+  Rng rng(17);
+  std::vector<Vec3f> pts;
+  for (int i = 0; i < 3000; ++i) {
+    float a = 2.0f * kPi * rng.uniform(), rr = 0.4f * std::sqrt(rng.uniform());
+    pts.push_back({0.3f + rr * std::cos(a), 0.0f, -0.2f + rr * std::sin(a)});
+  }
+  for (int i = 0; i < 300; ++i) pts.push_back({-3.0f + 6.0f * rng.uniform(), 5.0f * rng.uniform(), -2.5f});
+  pts.push_back({4.0f, 3.0f, 4.0f});
+  pts.push_back({4.05f, 3.0f, 4.0f});
+  const float r = 0.1f;
+  auto within = [&](Vec3f q) {
+    int n = 0;
+    for (Vec3f p : pts) {
+      float dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z;
+      n += dx * dx + dy * dy + dz * dz < r * r;
+    }
+    return n;
+  };
+  for (int m : {1, 2}) {
+    GuideOccupancy g = GuideOccupancy::build(pts, r, m);
+    REQUIRE(g.built());
+    int wrong = 0, no = 0, emptyNo = 0, empty = 0;
+    for (int i = 0; i < 20000; ++i) {
+      Vec3f q;
+      if (i % 2 == 0) {
+        q = {-5.0f + 10.0f * rng.uniform(), -0.5f + 6.0f * rng.uniform(), -3.0f + 8.0f * rng.uniform()};
+      } else {  // within r of a point, at 0.999-0.99999 of r
+        Vec3f p = pts[size_t(rng.uniform() * float(pts.size())) % pts.size()];
+        Vec3f d = normalize(Vec3f{rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f});
+        q = p + d * (r * (1.0f - std::pow(10.0f, -3.0f - 2.0f * rng.uniform())));
+      }
+      int n = within(q);
+      bool maybe = g.mayHaveNear(q);
+      wrong += !maybe && n >= m;
+      no += !maybe;
+      if (n == 0) {
+        ++empty;
+        emptyNo += !maybe;
+      }
+    }
+    MESSAGE("m " << m << ": grid says no for " << no << " queries, " << emptyNo << " of " << empty
+                 << " with no point near; set cells " << g.setCount() << " of " << g.cellCount());
+    CHECK(wrong == 0);
+    CHECK(emptyNo > 0.9 * empty);
+  }
+  // Coarser cells when the bounds would need too many: still exact.
+  GuideOccupancy coarse = GuideOccupancy::build(pts, r, 2, 1000);
+  CHECK(coarse.cellCount() <= 1000);
+  int wrong = 0;
+  for (int i = 0; i < 2000; ++i) {
+    Vec3f p = pts[size_t(i) % pts.size()];
+    wrong += !coarse.mayHaveNear(p + Vec3f{0.03f, 0.0f, 0.02f}) && within(p + Vec3f{0.03f, 0.0f, 0.02f}) >= 2;
+  }
+  CHECK(wrong == 0);
+  // Nothing to build from: always "maybe".
+  CHECK(GuideOccupancy::build({}, r, 2).mayHaveNear({0, 0, 0}));
 }
 
 TEST_CASE("caustic guide: guided and unguided path tracing agree in mean, on the image and on the caustic") {

@@ -100,6 +100,9 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
     }
     g.halfAngle_[i] = half;
   }
+  std::vector<Vec3f> positions(g.store_->size());
+  for (size_t i = 0; i < positions.size(); ++i) positions[i] = g.store_->position(i);
+  g.occupancy_ = GuideOccupancy::build(positions, radius, kMinFound);
   g.fraction_ = s.fraction;
   return g;
 }
@@ -109,6 +112,7 @@ void CausticGuide::conesAt(const Material& m, Vec3f p, Vec3f n, photon::KnnQuery
   out.totalSolidAngle = 0.0f;
   out.fraction = 0.0f;
   if (!enabled() || !diffuseLike(m)) return;
+  if (!occupancy_.mayHaveNear(p)) return;  // the k-NN would find < kMinFound
   int found = tree_.knn(p, kNeighbours, radius2_, q);
   if (found < kMinFound) return;
   Vec3f axis[kNeighbours];

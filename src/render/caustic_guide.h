@@ -32,6 +32,7 @@
 #include "core/progress.h"
 #include "photon/kdtree.h"
 #include "photon/store.h"
+#include "render/guide_occupancy.h"
 #include "render/guided_sampling.h"
 #include "sampling/sampler.h"
 #include "scene/scene.h"
@@ -57,6 +58,7 @@ class CausticGuide {
   bool enabled() const { return fraction_ > 0.0f; }
   size_t photonCount() const { return exits_.size(); }
   float radius() const { return std::sqrt(radius2_); }
+  const GuideOccupancy& occupancy() const { return occupancy_; }
   // Cones for a vertex at p on material m with shading normal n (on the
   // side the path arrived from); none for other than diffuse and plastic
   // materials, or with fewer than 3 guide photons within radius().
@@ -70,6 +72,9 @@ class CausticGuide {
   photon::KdTree tree_;
   std::vector<Vec3f> exits_;  // photon i's last specular vertex, same order
   std::vector<float> halfAngle_;  // photon i's cone half-angle (radians)
+  // Where a vertex cannot find kMinFound photons within the radius: there
+  // conesAt skips the k-NN (same result, most vertices are such).
+  GuideOccupancy occupancy_;
 };
 
 }  // namespace tdpm
