@@ -14,6 +14,12 @@ namespace tdpm {
 
 namespace {
 constexpr int kRouletteStartDepth = 3;
+// Diffuse vertices of an eye path that the caustic guide serves: the first
+// (a caustic seen) and the second (a caustic lighting what is seen). On
+// cube-caustic at 1024 spp (seeds 1, 2; docs/sampling.md) relMSE was 0.35
+// guiding the first only, 0.24 the first two, 0.23 all; a k-NN costs ~1-2
+// microseconds at random places in a 200k-photon guide.
+constexpr int kGuidedDiffuseVertices = 2;
 }
 
 template <class Stream>
@@ -33,6 +39,7 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
   float guideScale = 1.0f;
   bool lastDelta = true;  // the camera ray counts as "specular": no MIS on a direct hit
   float lastPdf = 0.0f;
+  int diffuseVertices = 0;  // non-delta vertices so far
   Vec3f lastP = origin;
   // maxDepth_ vertices scatter (next-event estimation and a BSDF sample);
   // the ray leaving the last one is still traced, for the emission and sky
@@ -60,15 +67,17 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
     const Material& mat = scene_.materials[scene_.objects[hit.object].material];
     ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
 
-    // Guide cones at every diffuse vertex: not only a caustic seen directly
-    // (or in a mirror), but also one lighting what is seen, e.g. the wall
-    // or the box's shadow lit by the bright caustic on the box top (wall ->
-    // box top -> glass -> lamp). With the first vertex guided only, such
-    // paths made 27% and 11% of cube-caustic's relMSE at 1024 spp (seeds 1
-    // and 2, docs/sampling.md). The guide's occupancy grid answers for most
+    // Guide cones at the first two diffuse vertices: not only a caustic
+    // seen directly (or in a mirror), but also one lighting what is seen,
+    // e.g. the wall or the box's shadow lit by the bright caustic on the box
+    // top (wall -> box top -> glass -> lamp). With the first vertex guided
+    // only, such paths made 27% and 11% of cube-caustic's relMSE at 1024
+    // spp (seeds 1 and 2). The guide's occupancy grid answers for most
     // vertices, away from every caustic, without a k-NN.
     GuideCones cones;
-    if (guide_ && !mat.isDeltaOnly()) guide_->conesAt(mat, hit.p, ctx.frame.n, ts.guideQuery, cones);
+    if (guide_ && !mat.isDeltaOnly() && diffuseVertices < kGuidedDiffuseVertices)
+      guide_->conesAt(mat, hit.p, ctx.frame.n, ts.guideQuery, cones);
+    if (!mat.isDeltaOnly()) ++diffuseVertices;
 
     // ---- next-event estimation ----
     if (!mat.isDeltaOnly())
