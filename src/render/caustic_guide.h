@@ -17,9 +17,9 @@
 // 1995, "Importance driven path tracing using the photon map", with exit
 // points instead of directions).
 //
-// At every diffuse-like vertex of an eye path, the k nearest guide photons
-// within a radius, stored on surfaces facing about the same way, give k
-// cones around the directions toward their exit points (as wide as those
+// At the first two diffuse-like vertices of an eye path, the k nearest
+// guide photons within a radius, stored on surfaces facing about the same
+// way, give k cones around the directions toward their exit points (as wide as those
 // directions' spread, or as the photons' own spacing if wider), mixed with
 // BSDF sampling by render/guided_sampling.h, which keeps the estimate
 // unbiased whatever the guide holds. Where the photons are far, the guide's

@@ -5,8 +5,9 @@
 // reference every photon-mapping method is judged against. Caustics from
 // delta lights (point, spot, sun) through specular chains cannot be found
 // by it: reference scenes for caustics use area lights. Caustics from area
-// lights are found far more often when each diffuse vertex aims part of
-// its samples where caustic photons came from (render/caustic_guide.h).
+// lights are found far more often when the first two diffuse vertices aim
+// part of their samples where caustic photons came from
+// (render/caustic_guide.h).
 #pragma once
 #include "core/rng.h"
 #include "photon/kdtree.h"
