@@ -211,7 +211,6 @@ TEST_CASE("caustic guide: in the ball's faint halo on the floor, the cones hold 
   REQUIRE(guide.enabled());
   Material diffuse;
   diffuse.type = Material::Type::Diffuse;
-  photon::KnnQuery q(CausticGuide::kNeighbours);
   Rng rng(3);
   const Vec3f n{0, 1, 0};
   int lamp = 0, covered = 0, guidedPoints = 0, points = 0;
@@ -221,7 +220,7 @@ TEST_CASE("caustic guide: in the ball's faint halo on the floor, the cones hold 
     float a = 2.0f * kPi * float(i) / 24.0f;
     Vec3f p{0.9f * std::cos(a), 0.0f, 0.9f * std::sin(a)};
     GuideCones cones;
-    guide.conesAt(diffuse, p, n, q, cones);
+    guide.conesAt(diffuse, p, n, cones);
     ++points;
     if (!cones.active()) continue;
     ++guidedPoints;
@@ -247,6 +246,42 @@ TEST_CASE("caustic guide: in the ball's faint halo on the floor, the cones hold 
   CHECK(guidedPoints >= points / 2);
   REQUIRE(lamp > 200);
   CHECK(covered > 0.9 * lamp);
+}
+
+TEST_CASE("caustic guide: its compact k-NN returns what the kd-tree's k-NN returns, bit for bit") {
+  // CausticGuide::nearest repeats KdTree::knn's traversal over 16-byte
+  // nodes; the cones (and images) depend on the order of the result too.
+  auto s = Scene::build(cubeCaustic(40, 30, 1.0f));
+  CausticGuideSettings gs;
+  gs.fraction = 0.5f;
+  gs.photons = 30000;
+  gs.seed = 5;
+  CausticGuide guide = CausticGuide::build(*s, gs, Progress{});
+  REQUIRE(guide.enabled());
+  photon::KnnQuery q(CausticGuide::kNeighbours);
+  Rng rng(11);
+  int differ = 0, full = 0, some = 0;
+  for (int i = 0; i < 20000; ++i) {
+    // Half near stored photons (dense and sparse places), half anywhere.
+    Vec3f p = i % 2 == 0 ? guide.tree().store().position(size_t(rng.uniform() * float(guide.photonCount())) %
+                                                         guide.photonCount()) +
+                               Vec3f{0.05f * (rng.uniform() - 0.5f), 0.01f * rng.uniform(), 0.05f * (rng.uniform() - 0.5f)}
+                         : Vec3f{-3.0f + 6.0f * rng.uniform(), 2.5f * rng.uniform(), -2.5f + 5.0f * rng.uniform()};
+    uint32_t index[CausticGuide::kNeighbours + 1];
+    float d2[CausticGuide::kNeighbours + 1];
+    int a = guide.nearest(p, index, d2);
+    int b = guide.tree().knn(p, CausticGuide::kNeighbours, guide.radius() * guide.radius(), q);
+    bool same = a == b;
+    for (int j = 0; same && j < a; ++j)
+      same = index[j] == q.index()[j] && std::memcmp(&d2[j], &q.dist2()[j], sizeof(float)) == 0;
+    differ += !same;
+    full += a == CausticGuide::kNeighbours;
+    some += a > 0 && a < CausticGuide::kNeighbours;
+  }
+  MESSAGE("queries with all 8 found " << full << ", with 1-7 " << some << "; differing " << differ);
+  CHECK(differ == 0);
+  CHECK(full > 2000);
+  CHECK(some > 500);
 }
 
 TEST_CASE("caustic guide: guided and unguided path tracing agree in mean, on the image and on the caustic") {

@@ -73,6 +73,11 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
   photon::KdBuildOptions options;
   options.order = &order;
   g.tree_ = photon::KdTree::build(*g.store_, options);
+  g.nodes_.resize(order.size());
+  for (size_t i = 0; i < order.size(); ++i) {
+    Vec3f x = g.store_->position(i);
+    g.nodes_[i] = {x.x, x.y, x.z, uint32_t(g.store_->splitAxis(i))};
+  }
   g.photons_.resize(order.size());
   for (size_t i = 0; i < order.size(); ++i) {
     g.photons_[i].exit = traced.exitPoints[order[i]].point;
@@ -135,19 +140,121 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
   return g;
 }
 
-void CausticGuide::conesAt(const Material& m, Vec3f p, Vec3f n, photon::KnnQuery& q, GuideCones& out) const {
+// photon::KdTree::knnImpl<3> for k = kNeighbours over nodes_: the same
+// descent, deferral, heap and tests in the same order (kept in step with
+// it; tests/test_caustic_guide.cpp compares the two on random queries).
+int CausticGuide::nearest(Vec3f p, uint32_t* idx, float* d2) const {
+  constexpr int k = kNeighbours;
+  const uint32_t n = uint32_t(nodes_.size());
+  if (n == 0 || !(radius2_ > 0.0f)) return 0;
+  const Node* N = nodes_.data();
+  const float key[3] = {p.x, p.y, p.z};
+  struct Deferred {
+    uint32_t node, far;
+    float cellDist2;
+    float offset[3];
+  };
+  Deferred stack[64];  // one per level at most; the tree is < 32 levels deep
+  float r2 = radius2_;
+  int count = 0, sp = 0;
+  float off[3] = {0.0f, 0.0f, 0.0f};
+  float cellDist2 = 0.0f;
+  auto siftDown = [&](int i) {
+    float d = d2[i];
+    uint32_t v = idx[i];
+    for (;;) {
+      int c = 2 * i + 1;
+      if (c >= k) break;
+      c += int(d2[c + 1] > d2[c]);
+      float dc = d2[c];
+      if (dc <= d) break;
+      d2[i] = dc;
+      idx[i] = idx[c];
+      i = c;
+    }
+    d2[i] = d;
+    idx[i] = v;
+  };
+  auto test = [&](uint32_t q) {
+    float dx = N[q].x - key[0], dy = N[q].y - key[1], dz = N[q].z - key[2];
+    float dist = dx * dx + dy * dy + dz * dz;
+    if (dist < r2) {
+      if (count < k) {
+        idx[count] = q;
+        d2[count] = dist;
+        if (++count == k) {
+          d2[k] = -std::numeric_limits<float>::infinity();
+          for (int i = k / 2 - 1; i >= 0; --i) siftDown(i);
+          r2 = d2[0];
+        }
+      } else {
+        d2[0] = dist;
+        idx[0] = q;
+        siftDown(0);
+        r2 = d2[0];
+      }
+    }
+  };
+  uint32_t node = 0;
+  for (;;) {
+    for (;;) {
+      uint32_t left = 2 * node + 1;
+      if (left >= n) {
+        test(node);
+        break;
+      }
+      uint32_t ahead = 16 * node + 15;
+      if (ahead < n) __builtin_prefetch(N + ahead);
+      int axis = int(N[node].axis);
+      float split = axis == 0 ? N[node].x : axis == 1 ? N[node].y : N[node].z;
+      float delta = split - key[axis];
+      uint32_t nearC = delta > 0.0f ? left : left + 1;
+      uint32_t farC = delta > 0.0f ? left + 1 : left;
+      float farDist2 = cellDist2 - off[axis] * off[axis] + delta * delta;
+      if (farDist2 < r2) {
+        Deferred& e = stack[sp++];
+        e.node = node;
+        e.far = farC < n ? farC : 0;
+        e.cellDist2 = farDist2;
+        for (int a = 0; a < 3; ++a) e.offset[a] = off[a];
+        e.offset[axis] = delta;
+      }
+      if (nearC >= n) break;
+      node = nearC;
+    }
+    bool found = false;
+    while (sp > 0) {
+      const Deferred& e = stack[--sp];
+      if (e.cellDist2 < r2) {
+        test(e.node);
+        if (e.far == 0 || !(e.cellDist2 < r2)) continue;
+        node = e.far;
+        cellDist2 = e.cellDist2;
+        for (int a = 0; a < 3; ++a) off[a] = e.offset[a];
+        found = true;
+        break;
+      }
+    }
+    if (!found) break;
+  }
+  return count;
+}
+
+void CausticGuide::conesAt(const Material& m, Vec3f p, Vec3f n, GuideCones& out) const {
   out.count = 0;
   out.totalSolidAngle = 0.0f;
   out.fraction = 0.0f;
   if (!enabled() || !diffuseLike(m)) return;
   if (!occupancy_.mayHaveNear(p)) return;  // the k-NN would find < kMinFound
-  int found = tree_.knn(p, kNeighbours, radius2_, q);
+  uint32_t index[kNeighbours + 1];
+  float d2[kNeighbours + 1];
+  int found = nearest(p, index, d2);
   if (found < kMinFound) return;
   Vec3f axis[kNeighbours];
   float omc[kNeighbours], dist2[kNeighbours];
   int count = 0;
   for (int i = 0; i < found; ++i) {
-    const GuidePhoton& o = photons_[q.index()[i]];
+    const GuidePhoton& o = photons_[index[i]];
     if (!(dot(o.normal, n) > kMinNormalCosine)) continue;
     Vec3f d = o.exit - p;
     float len = length(d);
@@ -155,7 +262,7 @@ void CausticGuide::conesAt(const Material& m, Vec3f p, Vec3f n, photon::KnnQuery
     d = d / len;
     if (dot(d, n) > kMinCosine) {
       omc[count] = o.oneMinusCos;
-      dist2[count] = q.dist2()[i];
+      dist2[count] = d2[i];
       axis[count++] = d;
     }
   }

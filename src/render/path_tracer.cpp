@@ -23,7 +23,7 @@ constexpr int kGuidedDiffuseVertices = 2;
 }
 
 template <class Stream>
-Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts) const {
+Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState&) const {
   Rgb L(0.0f), beta(1.0f);
   // Product of eta^2 over the refractions so far: the radiance scaling
   // 1/eta^2 a refraction puts into beta is undone for Russian roulette,
@@ -76,7 +76,7 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
     // vertices, away from every caustic, without a k-NN.
     GuideCones cones;
     if (guide_ && !mat.isDeltaOnly() && diffuseVertices < kGuidedDiffuseVertices)
-      guide_->conesAt(mat, hit.p, ctx.frame.n, ts.guideQuery, cones);
+      guide_->conesAt(mat, hit.p, ctx.frame.n, cones);
     if (!mat.isDeltaOnly()) ++diffuseVertices;
 
     // ---- next-event estimation ----

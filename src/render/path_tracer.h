@@ -23,10 +23,9 @@ class PathTracer {
   PathTracer(const Scene& scene, int maxDepth, const CausticGuide* guide = nullptr)
       : scene_(scene), maxDepth_(maxDepth), guide_(guide && guide->enabled() ? guide : nullptr) {}
 
-  // Per-thread scratch: the guide's k-NN buffer.
-  struct ThreadState {
-    photon::KnnQuery guideQuery{CausticGuide::kNeighbours};
-  };
+  // Per-thread scratch: none at present (the guide's k-NN keeps its few
+  // candidates on the stack); kept so that callers need not change.
+  struct ThreadState {};
   // Radiance arriving at `origin` from direction `dir`, at time time01.
   // Stream: RandomStream or SobolStream (sampling/sampler.h); draws follow
   // its dimension order, vertex = depth.
