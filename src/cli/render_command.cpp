@@ -309,9 +309,9 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
       ->check(rangeOf(limits::kFilterRadius));
   c->add_option("--max-depth", a.maxDepth, "Maximum path length in vertices (default 16)")->check(rangeOf(limits::kMaxDepth));
   c->add_option("--caustic-guiding", a.causticGuiding,
-                "pathtrace: share of the first diffuse vertex's continuation samples aimed where nearby caustic "
-                "photons left the last mirror or glass (a small photon map traced first; an unbiased mixture with "
-                "the BSDF; 0 turns it off; default 0.5; docs/sampling.md)")
+                "pathtrace: share of the first two diffuse vertices' continuation samples aimed where nearby caustic "
+                "photons left the last mirror or glass (a small photon map traced first; less where those photons "
+                "are far; an unbiased mixture with the BSDF; 0 turns it off; default 0.5; docs/sampling.md)")
       ->check(rangeOf(limits::kCausticGuiding));
   c->add_option("--resolution", a.resolution, "Image size WxH (overrides the scene), e.g. 640x480");
   c->add_option("--exposure", a.exposure, "PNG preview exposure in stops (the EXR is unaffected)")

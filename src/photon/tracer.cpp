@@ -348,7 +348,7 @@ struct Tracer {
   // Traces paths [first, first + count) of batch `b` into `out`, energies
   // scaled by `energyScale` (= ts / n_e). Returns nothing: out grows.
   // Returns the number of rays cast.
-  uint64_t traceBatch(uint64_t local, double energyScale, PhotonStore& out, std::vector<Vec3f>* exits) const {
+  uint64_t traceBatch(uint64_t local, double energyScale, PhotonStore& out, std::vector<ExitPoint>* exits) const {
     uint64_t b = batchOffset + local;
     Rng rng(hashCombine(settings.seed, uint64_t(settings.kind) + 1, b), 0x9e37);
     // sobol: the path index is the sample index, the map's seed and kind the "pixel".
@@ -393,7 +393,7 @@ struct Tracer {
   // exits (caustic maps, optional): receives each stored photon's last
   // specular vertex, in store order.
   template <class Stream>
-  uint64_t tracePath(float time01, Stream& rng, double energyScale, PhotonStore& out, std::vector<Vec3f>* exits) const {
+  uint64_t tracePath(float time01, Stream& rng, double energyScale, PhotonStore& out, std::vector<ExitPoint>* exits) const {
     uint64_t rays = 0;
     uint32_t li = lights.pick(rng.get1D(dims::kPhotonLight));
     const Light& light = scene.lights[li];
@@ -427,7 +427,7 @@ struct Tracer {
         // of the same object (photon/surface_tag.h).
         if (store) {
           out.add(hit.p, power * float(energyScale), -dir, time, surfaceTag(hit.object, dot(hit.n, dir) > 0.0f));
-          if (exits) exits->push_back(lastSpecular);
+          if (exits) exits->push_back({lastSpecular, dot(hit.n, dir) > 0.0f ? -hit.n : hit.n});
         }
         if (settings.kind == MapKind::Caustic && !glossyBounce) return rays;  // L (S|G)+ D ends here
       }
@@ -456,7 +456,7 @@ struct Tracer {
   // per photon instead of holding every batch buffer and the result at once.
   PhotonStore traceBatches(uint64_t firstBatch, uint64_t endBatch, double energyScale, const Progress& progress,
                            const char* stage, size_t expected, uint64_t* raysOut = nullptr,
-                           std::vector<Vec3f>* exitsOut = nullptr) const {
+                           std::vector<ExitPoint>* exitsOut = nullptr) const {
     PhotonStore all(t0, t1);
     all.reserve(expected);
     std::atomic<uint64_t> rays{0};
@@ -466,7 +466,7 @@ struct Tracer {
     const size_t paths = size_t(batches) * kPathsPerBatch;
     progress(stage, 0, paths);
     std::vector<PhotonStore> parts;
-    std::vector<std::vector<Vec3f>> partExits;
+    std::vector<std::vector<ExitPoint>> partExits;
     for (uint64_t first = firstBatch; first < endBatch; first += kBatchesPerChunk) {
       size_t count = size_t(std::min<uint64_t>(kBatchesPerChunk, endBatch - first));
       parts.assign(count, PhotonStore(t0, t1));
@@ -478,7 +478,7 @@ struct Tracer {
         }
       });
       all.appendBatches(parts);
-      for (const std::vector<Vec3f>& e : partExits) exitsOut->insert(exitsOut->end(), e.begin(), e.end());
+      for (const std::vector<ExitPoint>& e : partExits) exitsOut->insert(exitsOut->end(), e.begin(), e.end());
     }
     if (raysOut) *raysOut = rays.load();
     return all;

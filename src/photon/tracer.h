@@ -62,7 +62,8 @@ struct TraceSettings {
   // The path tracer's caustic guide (render/caustic_guide.h): emit from area
   // lights only (point, spot and sun caustics are not paths a path tracer
   // can find), and keep each stored photon's last specular vertex in
-  // TraceResult::exitPoints (one process only, not under MPI).
+  // TraceResult::exitPoints, with the normal of the surface it was stored
+  // on (one process only, not under MPI).
   bool areaLightsOnly = false;
   bool keepExitPoints = false;
   // Caustic map: sharp metals (Material::isGlossy) bounce caustic paths
@@ -75,6 +76,13 @@ struct TraceSettings {
 // Paths per batch: the unit of emission counts and of TraceSettings::firstPath.
 constexpr uint64_t kPathsPerBatch = 1024;
 
+// A caustic photon's last specular vertex, and the normal of the surface
+// it was stored on, facing the side it arrived from.
+struct ExitPoint {
+  Vec3f point;
+  Vec3f normal;
+};
+
 struct TraceResult {
   PhotonStore store;
   uint64_t emitted = 0;  // n_e: paths emitted from all lights
@@ -82,7 +90,7 @@ struct TraceResult {
   double seconds = 0;
   std::string warning;   // set when the map is empty or smaller than wanted
   double storedPerPath = 0;  // the pilot's rate (or the one given), 0 when nothing is stored
-  std::vector<Vec3f> exitPoints;  // keepExitPoints: photon i's last specular vertex, in store order
+  std::vector<ExitPoint> exitPoints;  // keepExitPoints: photon i's, in store order
 };
 
 // Shutter interval the photon store quantises time over. A zero-length

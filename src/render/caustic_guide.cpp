@@ -16,16 +16,37 @@ namespace {
 
 constexpr int kMinFound = 2;               // fewer photons near a vertex: no guide there
 constexpr float kMinCosine = 0.05f;        // a cone's axis must be above the surface
+// A photon counts for a vertex when the normal of the surface it was
+// stored on is within 60 degrees of the vertex's: where two faces meet
+// (the box's side and top, the floor and the box's side low in the
+// shutter), a photon on the other face landed by another geometry. (Not
+// measured alone: cube-caustic's points 1 cm below the box top's edge get
+// no cones either way, their exit directions point into the box.)
+constexpr float kMinNormalCosine = 0.5f;
 constexpr float kMinHalfAngle = 0.0044f;   // 0.25 degrees
 constexpr float kMaxHalfAngle = 0.14f;     // 8 degrees: wider is no longer a guide
-// Search radius: 4x the median k-NN radius. Where the caustic is dim (the
+// Search radius: 4x the median k-NN radius r0. Where the caustic is dim (the
 // box's shadow on the floor, which the ball's halo reaches) photons are
 // sparse, but those pixels are dark, so their rare caustic paths are what
 // the relative error is made of; the exit points keep far photons' cones
-// pointing right (measured on cube-caustic, 8 seeds x 64 spp: 2x the
-// radius and at least 4 photons gave relMSE mean 31 / MSE 0.85, this
-// 2.2 / 0.74; unguided 31.6 / 1.46).
+// pointing right (measured on cube-caustic at 1024 spp, seed 1: 2x the
+// radius gave relMSE 0.81 against refA, this 0.29: shadow pixels without
+// cones then, docs/sampling.md).
 constexpr float kRadiusScale = 4.0f;
+// Trust: where the vertex's photons lie farther than r0 (median distance),
+// their cones are less sure to hold the lamp's image, and a guide that
+// misses makes the BSDF's own finds weigh 1/(1 - c): c falls as
+// (r0 / distance)^2, to c/16 at the search radius.
+constexpr float kTrustRadiusScale = 1.0f;
+
+const float kMaxOneMinusCos = 2.0f * std::sin(0.5f * kMaxHalfAngle) * std::sin(0.5f * kMaxHalfAngle);
+
+// The upper median of v[0..n) (n <= kNeighbours), by insertion sort.
+float median(float* v, int n) {
+  for (int i = 1; i < n; ++i)
+    for (int j = i; j > 0 && v[j] < v[j - 1]; --j) std::swap(v[j], v[j - 1]);
+  return v[n / 2];
+}
 
 bool diffuseLike(const Material& m) {
   return m.type == Material::Type::Diffuse || m.type == Material::Type::Plastic;
@@ -53,8 +74,16 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
   photon::KdBuildOptions options;
   options.order = &order;
   g.tree_ = photon::KdTree::build(*g.store_, options);
-  g.exits_.resize(order.size());
-  for (size_t i = 0; i < order.size(); ++i) g.exits_[i] = traced.exitPoints[order[i]];
+  g.nodes_.resize(order.size());
+  for (size_t i = 0; i < order.size(); ++i) {
+    Vec3f x = g.store_->position(i);
+    g.nodes_[i] = {x.x, x.y, x.z, uint32_t(g.store_->splitAxis(i))};
+  }
+  g.photons_.resize(order.size());
+  for (size_t i = 0; i < order.size(); ++i) {
+    g.photons_[i].exit = traced.exitPoints[order[i]].point;
+    g.photons_[i].normal = traced.exitPoints[order[i]].normal;
+  }
 
   // Search radius: the k-NN radius at (up to) 256 photons spread through
   // the map, median, doubled: where the caustic is, a vertex finds its k.
@@ -67,22 +96,25 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
   if (r.empty()) return CausticGuide();
   std::nth_element(r.begin(), r.begin() + long(r.size() / 2), r.end());
   float radius = kRadiusScale * r[r.size() / 2];
+  g.trust2_ = kTrustRadiusScale * kTrustRadiusScale * r[r.size() / 2] * r[r.size() / 2];
   if (!(radius > 0.0f) || !std::isfinite(radius)) return CausticGuide();
   g.radius2_ = radius * radius;
 
   // Each photon's cone half-angle, once: 1.5x the median angle, seen from
   // the photon, between its k nearest photons' exit directions and their
   // own nearest other, so the cones join into one cover of the light's
-  // image. A vertex takes the median of its photons' half-angles.
-  g.halfAngle_.resize(g.exits_.size());
+  // image. A vertex takes the median of its photons' half-angles (or the
+  // spread of its own photons' directions, if wider). Kept as 1 - cos.
   photon::KnnQuery nq(kNeighbours);
-  for (size_t i = 0; i < g.exits_.size(); ++i) {
+  for (size_t i = 0; i < g.photons_.size(); ++i) {
     Vec3f p = g.store_->position(i);
     int found = g.tree_.knn(p, kNeighbours, g.radius2_, nq);
     Vec3f axis[kNeighbours];
     int count = 0;
     for (int j = 0; j < found; ++j) {
-      Vec3f d = g.exits_[nq.index()[j]] - p;
+      const GuidePhoton& o = g.photons_[nq.index()[j]];
+      if (!(dot(o.normal, g.photons_[i].normal) > kMinNormalCosine)) continue;
+      Vec3f d = o.exit - p;
       float len = length(d);
       if (len > 0.0f) axis[count++] = d / len;
     }
@@ -99,40 +131,162 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
       float angle = 2.0f * std::asin(std::min(1.0f, 0.5f * std::sqrt(nearest[count / 2])));
       half = std::clamp(1.5f * angle, kMinHalfAngle, kMaxHalfAngle);
     }
-    g.halfAngle_[i] = half;
+    float sh = std::sin(0.5f * half);
+    g.photons_[i].oneMinusCos = 2.0f * sh * sh;
   }
+  std::vector<Vec3f> positions(g.store_->size());
+  for (size_t i = 0; i < positions.size(); ++i) positions[i] = g.store_->position(i);
+  g.occupancy_ = GuideOccupancy::build(positions, radius, kMinFound);
   g.fraction_ = s.fraction;
   return g;
 }
 
-void CausticGuide::conesAt(const Material& m, Vec3f p, Vec3f n, photon::KnnQuery& q, GuideCones& out) const {
+// photon::KdTree::knnImpl<3> for k = kNeighbours over nodes_: the same
+// descent, deferral, heap and tests in the same order (kept in step with
+// it; tests/test_caustic_guide.cpp compares the two on random queries).
+int CausticGuide::nearest(Vec3f p, uint32_t* idx, float* d2) const {
+  constexpr int k = kNeighbours;
+  const uint32_t n = uint32_t(nodes_.size());
+  if (n == 0 || !(radius2_ > 0.0f)) return 0;
+  const Node* N = nodes_.data();
+  const float key[3] = {p.x, p.y, p.z};
+  struct Deferred {
+    uint32_t node, far;
+    float cellDist2;
+    float offset[3];
+  };
+  Deferred stack[64];  // one per level at most; the tree is < 32 levels deep
+  float r2 = radius2_;
+  int count = 0, sp = 0;
+  float off[3] = {0.0f, 0.0f, 0.0f};
+  float cellDist2 = 0.0f;
+  auto siftDown = [&](int i) {
+    float d = d2[i];
+    uint32_t v = idx[i];
+    for (;;) {
+      int c = 2 * i + 1;
+      if (c >= k) break;
+      c += int(d2[c + 1] > d2[c]);
+      float dc = d2[c];
+      if (dc <= d) break;
+      d2[i] = dc;
+      idx[i] = idx[c];
+      i = c;
+    }
+    d2[i] = d;
+    idx[i] = v;
+  };
+  auto test = [&](uint32_t q) {
+    float dx = N[q].x - key[0], dy = N[q].y - key[1], dz = N[q].z - key[2];
+    float dist = dx * dx + dy * dy + dz * dz;
+    if (dist < r2) {
+      if (count < k) {
+        idx[count] = q;
+        d2[count] = dist;
+        if (++count == k) {
+          d2[k] = -std::numeric_limits<float>::infinity();
+          for (int i = k / 2 - 1; i >= 0; --i) siftDown(i);
+          r2 = d2[0];
+        }
+      } else {
+        d2[0] = dist;
+        idx[0] = q;
+        siftDown(0);
+        r2 = d2[0];
+      }
+    }
+  };
+  uint32_t node = 0;
+  for (;;) {
+    for (;;) {
+      uint32_t left = 2 * node + 1;
+      if (left >= n) {
+        test(node);
+        break;
+      }
+      uint32_t ahead = 16 * node + 15;
+      if (ahead < n) __builtin_prefetch(N + ahead);
+      int axis = int(N[node].axis);
+      float split = axis == 0 ? N[node].x : axis == 1 ? N[node].y : N[node].z;
+      float delta = split - key[axis];
+      uint32_t nearC = delta > 0.0f ? left : left + 1;
+      uint32_t farC = delta > 0.0f ? left + 1 : left;
+      float farDist2 = cellDist2 - off[axis] * off[axis] + delta * delta;
+      if (farDist2 < r2) {
+        Deferred& e = stack[sp++];
+        e.node = node;
+        e.far = farC < n ? farC : 0;
+        e.cellDist2 = farDist2;
+        for (int a = 0; a < 3; ++a) e.offset[a] = off[a];
+        e.offset[axis] = delta;
+      }
+      if (nearC >= n) break;
+      node = nearC;
+    }
+    bool found = false;
+    while (sp > 0) {
+      const Deferred& e = stack[--sp];
+      if (e.cellDist2 < r2) {
+        test(e.node);
+        if (e.far == 0 || !(e.cellDist2 < r2)) continue;
+        node = e.far;
+        cellDist2 = e.cellDist2;
+        for (int a = 0; a < 3; ++a) off[a] = e.offset[a];
+        found = true;
+        break;
+      }
+    }
+    if (!found) break;
+  }
+  return count;
+}
+
+void CausticGuide::conesAt(const Material& m, Vec3f p, Vec3f n, GuideCones& out) const {
   out.count = 0;
   out.totalSolidAngle = 0.0f;
   out.fraction = 0.0f;
   if (!enabled() || !diffuseLike(m)) return;
-  int found = tree_.knn(p, kNeighbours, radius2_, q);
+  if (!occupancy_.mayHaveNear(p)) return;  // the k-NN would find < kMinFound
+  uint32_t index[kNeighbours + 1];
+  float d2[kNeighbours + 1];
+  int found = nearest(p, index, d2);
   if (found < kMinFound) return;
   Vec3f axis[kNeighbours];
+  float omc[kNeighbours], dist2[kNeighbours];
   int count = 0;
   for (int i = 0; i < found; ++i) {
-    Vec3f d = exits_[q.index()[i]] - p;
+    const GuidePhoton& o = photons_[index[i]];
+    if (!(dot(o.normal, n) > kMinNormalCosine)) continue;
+    Vec3f d = o.exit - p;
     float len = length(d);
     if (!(len > 0.0f)) continue;
     d = d / len;
-    if (dot(d, n) > kMinCosine) axis[count++] = d;
+    if (dot(d, n) > kMinCosine) {
+      omc[count] = o.oneMinusCos;
+      dist2[count] = d2[i];
+      axis[count++] = d;
+    }
   }
   if (count < kMinFound) return;
-  float halves[kNeighbours];
-  for (int i = 0; i < found; ++i) halves[i] = halfAngle_[q.index()[i]];
-  std::nth_element(halves, halves + found / 2, halves + found);
-  float half = halves[found / 2];
-  float s = std::sin(0.5f * half);
-  float oneMinusCos = 2.0f * s * s;
+  float fraction = fraction_;
+  float medianDist2 = median(dist2, count);
+  if (medianDist2 > trust2_) fraction *= trust2_ / medianDist2;
+  // Cones as wide as the farthest of the vertex's own directions from
+  // their mean, when that is wider than the photons' spacing: the
+  // neighbours' exit directions spread over the lamp's whole image (~1
+  // degree from the floor), and cones only as wide as their spacing left
+  // gaps in it (docs/sampling.md). 1 - cos(angle) = chord^2 / 2.
+  Vec3f mean(0.0f);
+  for (int i = 0; i < count; ++i) mean += axis[i];
+  mean = normalize(mean);
+  float chord2 = 0.0f;
+  for (int i = 0; i < count; ++i) chord2 = std::max(chord2, lengthSquared(axis[i] - mean));
+  float oneMinusCos = std::min(kMaxOneMinusCos, std::max(median(omc, count), 0.5f * chord2));
   float omega = 2.0f * kPi * oneMinusCos;
   for (int i = 0; i < count; ++i) out.cone[size_t(i)] = {axis[i], oneMinusCos, omega};
   out.count = count;
   out.totalSolidAngle = omega * float(count);
-  out.fraction = fraction_;
+  out.fraction = fraction;
 }
 
 }  // namespace tdpm

@@ -17,11 +17,15 @@
 // 1995, "Importance driven path tracing using the photon map", with exit
 // points instead of directions).
 //
-// At the first diffuse-like vertex of an eye path, the k nearest guide
-// photons within a radius give k cones around those directions (half-angle
-// from their own spread), mixed with BSDF sampling by
-// render/guided_sampling.h, which keeps the estimate unbiased whatever the
-// guide holds. The guide is a fixed function of the scene and the seed,
+// At the first two diffuse-like vertices of an eye path, the k nearest
+// guide photons within a radius, stored on surfaces facing about the same
+// way, give k cones around the directions toward their exit points (as wide as those
+// directions' spread, or as the photons' own spacing if wider), mixed with
+// BSDF sampling by render/guided_sampling.h, which keeps the estimate
+// unbiased whatever the guide holds. Where the photons are far, the guide's
+// share of the mixture falls. An occupancy grid (render/guide_occupancy.h)
+// answers, without the k-NN, for the many vertices with no photon near. The
+// guide is a fixed function of the scene and the seed,
 // built before any pixel by every process alike, so images stay identical
 // across threads and MPI ranks.
 #pragma once
@@ -32,6 +36,7 @@
 #include "core/progress.h"
 #include "photon/kdtree.h"
 #include "photon/store.h"
+#include "render/guide_occupancy.h"
 #include "render/guided_sampling.h"
 #include "sampling/sampler.h"
 #include "scene/scene.h"
@@ -55,21 +60,46 @@ class CausticGuide {
   static CausticGuide build(const Scene& scene, const CausticGuideSettings& settings, const Progress& progress);
 
   bool enabled() const { return fraction_ > 0.0f; }
-  size_t photonCount() const { return exits_.size(); }
+  size_t photonCount() const { return photons_.size(); }
   float radius() const { return std::sqrt(radius2_); }
+  const GuideOccupancy& occupancy() const { return occupancy_; }
   // Cones for a vertex at p on material m with shading normal n (on the
-  // side the path arrived from); none for other than diffuse and plastic
-  // materials, or with fewer than 3 guide photons within radius().
-  // q: the calling thread's query buffer (capacity >= kNeighbours).
-  void conesAt(const Material& m, Vec3f p, Vec3f n, photon::KnnQuery& q, GuideCones& out) const;
+  // side the path arrived from), and the mixture weight c there (at most
+  // the settings' fraction); none for other than diffuse and plastic
+  // materials, or with fewer than 2 usable guide photons within radius().
+  void conesAt(const Material& m, Vec3f p, Vec3f n, GuideCones& out) const;
+
+  // The kNeighbours nearest guide photons to p within radius(): their tree
+  // indices and squared distances, in the order photon::KdTree::knn gives
+  // (same traversal, same comparisons, so the same result bit for bit),
+  // read from one 16-byte record per tree node instead of the store's four
+  // arrays: at random places of a 200k-photon guide the k-NN waits on
+  // memory, one cache miss per visited node instead of four. Returns count.
+  int nearest(Vec3f p, uint32_t* index, float* dist2) const;
+  const photon::KdTree& tree() const { return tree_; }
 
  private:
   float fraction_ = 0.0f;
   float radius2_ = 0.0f;
+  float trust2_ = 0.0f;  // (median k-NN radius)^2: beyond it c falls
   std::unique_ptr<photon::PhotonStore> store_;  // positions, in the tree's order
   photon::KdTree tree_;
-  std::vector<Vec3f> exits_;  // photon i's last specular vertex, same order
-  std::vector<float> halfAngle_;  // photon i's cone half-angle (radians)
+  struct Node {  // tree node i = photon i: position and split axis
+    float x, y, z;
+    uint32_t axis;
+  };
+  std::vector<Node> nodes_;
+  // What a vertex reads of each of its photons, in one record (one cache
+  // line fetch per photon), in the tree's order.
+  struct GuidePhoton {
+    Vec3f exit;         // last specular vertex
+    Vec3f normal;       // of the surface it was stored on, facing its arrival
+    float oneMinusCos;  // 1 - cos of its cone's half-angle
+  };
+  std::vector<GuidePhoton> photons_;
+  // Where a vertex cannot find kMinFound photons within the radius: there
+  // conesAt skips the k-NN (same result, most vertices are such).
+  GuideOccupancy occupancy_;
 };
 
 }  // namespace tdpm

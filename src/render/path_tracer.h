@@ -5,8 +5,9 @@
 // reference every photon-mapping method is judged against. Caustics from
 // delta lights (point, spot, sun) through specular chains cannot be found
 // by it: reference scenes for caustics use area lights. Caustics from area
-// lights are found far more often when the first diffuse vertex aims part
-// of its samples where caustic photons came from (render/caustic_guide.h).
+// lights are found far more often when the first two diffuse vertices aim
+// part of their samples where caustic photons came from
+// (render/caustic_guide.h).
 #pragma once
 #include "core/rng.h"
 #include "photon/kdtree.h"
@@ -22,10 +23,9 @@ class PathTracer {
   PathTracer(const Scene& scene, int maxDepth, const CausticGuide* guide = nullptr)
       : scene_(scene), maxDepth_(maxDepth), guide_(guide && guide->enabled() ? guide : nullptr) {}
 
-  // Per-thread scratch: the guide's k-NN buffer.
-  struct ThreadState {
-    photon::KnnQuery guideQuery{CausticGuide::kNeighbours};
-  };
+  // Per-thread scratch: none at present (the guide's k-NN keeps its few
+  // candidates on the stack); kept so that callers need not change.
+  struct ThreadState {};
   // Radiance arriving at `origin` from direction `dir`, at time time01.
   // Stream: RandomStream or SobolStream (sampling/sampler.h); draws follow
   // its dimension order, vertex = depth.

@@ -50,9 +50,10 @@ struct RenderOptions {
   FilterKind filter = FilterKind::Box;       // sampling/filter.h
   float filterRadius = 0.0f;                 // pixels; 0: the kind's default
   int maxDepth = 16;
-  // Path tracing: the share of the first diffuse vertex's continuation
-  // samples aimed where caustic photons came from (render/caustic_guide.h;
-  // 0 samples the BSDF alone), and the photons that guide is built from
+  // Path tracing: the share (at most) of the first two diffuse vertices'
+  // continuation samples aimed where caustic photons came from
+  // (render/caustic_guide.h; 0 samples the BSDF alone), and the photons
+  // that guide is built from
   // (0: one per 100 camera samples, 20k to 200k).
   float causticGuiding = 0.5f;
   size_t guidePhotons = 0;

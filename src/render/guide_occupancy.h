@@ -1,0 +1,60 @@
+// render/guide_occupancy.h — a bit per grid cell saying whether a point in
+// the cell can have at least m of a fixed point set within radius r.
+//
+// Why: the caustic guide (render/caustic_guide.h) asks a k-NN query at
+// every eye path's diffuse vertex, and most of those vertices (walls, most
+// of the floor) have no guide photon near; the k-NN then walks the tree
+// only to find nothing. A cleared bit answers "fewer than m points lie
+// within r of p" exactly (the k-NN would return fewer than m), in a few
+// instructions; a set bit only says "maybe" and the k-NN decides. So
+// skipping on a cleared bit never changes a result.
+//
+// A cell's bit is set when at least m points lie within r of the cell's box
+// (not only of its centre), with a margin for float rounding of the query's
+// cell index and of the k-NN's distances.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "math/vec.h"
+
+namespace tdpm {
+
+class GuideOccupancy {
+ public:
+  GuideOccupancy() = default;  // empty: mayHaveNear() is always true
+
+  // Cells are r/2 wide (wider if the points' bounds grown by r would need
+  // more than maxCells). The k-NN this stands for counts a point when its
+  // squared distance is < r^2.
+  static GuideOccupancy build(const std::vector<Vec3f>& points, float radius, int minCount,
+                              size_t maxCells = size_t(1) << 24);
+
+  // false: fewer than minCount points lie within the radius of p (exact).
+  // true: maybe (or no grid was built).
+  bool mayHaveNear(Vec3f p) const {
+    if (!built_) return true;
+    float fx = (p.x - lo_.x) * invCell_, fy = (p.y - lo_.y) * invCell_, fz = (p.z - lo_.z) * invCell_;
+    // Outside the grid (which holds every point grown by the radius), or NaN.
+    if (!(fx >= 0.0f && fy >= 0.0f && fz >= 0.0f && fx < float(nx_) && fy < float(ny_) && fz < float(nz_)))
+      return false;
+    size_t c = cellIndex(int(fx), int(fy), int(fz));
+    return (bits_[c >> 6] >> (c & 63)) & 1u;
+  }
+
+  bool built() const { return built_; }
+  float cellSize() const { return cell_; }
+  size_t cellCount() const { return size_t(nx_) * size_t(ny_) * size_t(nz_); }
+  size_t setCount() const;  // cells whose bit is set (for stats and tests)
+
+ private:
+  size_t cellIndex(int x, int y, int z) const { return (size_t(z) * size_t(ny_) + size_t(y)) * size_t(nx_) + size_t(x); }
+
+  bool built_ = false;
+  Vec3f lo_;
+  float cell_ = 0.0f, invCell_ = 0.0f;
+  int nx_ = 0, ny_ = 0, nz_ = 0;
+  std::vector<uint64_t> bits_;
+};
+
+}  // namespace tdpm
