@@ -1,8 +1,14 @@
 // tests/test_dist.cpp — the distribution module (dist/) and the render's
 // split of work, without MPI: block ranges of photon batches, the tile
 // interleave, pixel sharing with one process, error agreement, launcher
-// detection. The multi-process runs are in tests/test_dist_mpi.cpp.
+// detection, Nagle off on the link to the launcher. The multi-process runs are in tests/test_dist_mpi.cpp.
 #include <doctest/doctest.h>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -15,6 +21,7 @@
 #include <tbb/task_arena.h>
 
 #include "dist/comm.h"
+#include "dist/launcher_link.h"
 #include "render/pixel_share.h"
 #include "render/tile_loop.h"
 
@@ -116,6 +123,87 @@ TEST_CASE("dist: a launcher is recognised from its environment, a plain run is n
   unsetenv("PMI_SIZE");
   unsetenv("PMI_RANK");
   for (auto& kv : saved) setenv(kv.first.c_str(), kv.second.c_str(), 1);
+}
+
+TEST_CASE("dist: the PMIx server's address is read from the launcher's URI; anything else is refused") {
+  dist::TcpEndpoint e;
+  REQUIRE(dist::parsePmixServerUri("602996736.0;tcp4://127.0.0.1:51875", e));
+  CHECK(e.family == AF_INET);
+  CHECK(e.port == 51875);
+  CHECK((e.address[0] == 127 && e.address[1] == 0 && e.address[2] == 0 && e.address[3] == 1));
+  REQUIRE(dist::parsePmixServerUri("602996736.0;tcp6://[::1]:33127", e));
+  CHECK(e.family == AF_INET6);
+  CHECK(e.port == 33127);
+  CHECK(e.address[15] == 1);
+  for (const char* bad : {"", "602996736.0", "602996736.0;tcp4://127.0.0.1", "602996736.0;tcp4://127.0.0.1:0",
+                          "602996736.0;tcp4://127.0.0.1:70000", "602996736.0;tcp4://localhost:5", "x;usock://a:5",
+                          "602996736.0;tcp4://127.0.0.1:12x"})
+    CHECK_MESSAGE(!dist::parsePmixServerUri(bad, e), bad);
+}
+
+namespace {
+// A listening TCP socket on 127.0.0.1 (ephemeral port) and a client connected to it.
+struct LoopbackLink {
+  int server = -1, client = -1, accepted = -1;
+  dist::TcpEndpoint endpoint;
+  LoopbackLink() {
+    server = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    REQUIRE(bind(server, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0);
+    REQUIRE(listen(server, 1) == 0);
+    socklen_t len = sizeof a;
+    REQUIRE(getsockname(server, reinterpret_cast<sockaddr*>(&a), &len) == 0);
+    client = socket(AF_INET, SOCK_STREAM, 0);
+    REQUIRE(connect(client, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0);
+    accepted = accept(server, nullptr, nullptr);
+    REQUIRE(accepted >= 0);
+    REQUIRE(dist::parsePmixServerUri("1.0;tcp4://127.0.0.1:" + std::to_string(ntohs(a.sin_port)), endpoint));
+  }
+  ~LoopbackLink() {
+    for (int fd : {server, client, accepted})
+      if (fd >= 0) close(fd);
+  }
+  bool noDelay(int fd) const {
+    int v = 0;
+    socklen_t len = sizeof v;
+    return getsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &v, &len) == 0 && v != 0;
+  }
+};
+}  // namespace
+
+TEST_CASE("dist: Nagle is turned off on the connections to the PMIx server, and on no other socket") {
+  LoopbackLink pmix, other;
+  REQUIRE_FALSE(pmix.noDelay(pmix.client));  // Linux's default: Nagle on
+  REQUIRE_FALSE(other.noDelay(other.client));
+  // The server's URI as the launcher puts it in the environment.
+  const char* names[] = {"PMIX_SERVER_URI41", "PMIX_SERVER_URI4", "PMIX_SERVER_URI3", "PMIX_SERVER_URI21",
+                         "PMIX_SERVER_URI2"};
+  std::vector<std::pair<std::string, std::string>> saved;
+  for (const char* n : names)
+    if (const char* v = std::getenv(n)) saved.emplace_back(n, v);
+  for (const char* n : names) unsetenv(n);
+  CHECK(dist::pmixServerEndpoints().empty());
+  const std::string uri = "1.0;tcp4://127.0.0.1:" + std::to_string(pmix.endpoint.port);
+  setenv("PMIX_SERVER_URI4", uri.c_str(), 1);
+  setenv("PMIX_SERVER_URI3", uri.c_str(), 1);
+  std::vector<dist::TcpEndpoint> servers = dist::pmixServerEndpoints();
+  for (const char* n : names) unsetenv(n);
+  for (auto& kv : saved) setenv(kv.first.c_str(), kv.second.c_str(), 1);
+  REQUIRE(servers.size() == 1);  // the same URI twice: one endpoint
+  CHECK(servers[0] == pmix.endpoint);
+
+  bool allNoDelay = true;
+  CHECK(dist::countConnectionsTo(servers, &allNoDelay) == 1);  // the client end (the accepted end's peer differs)
+  CHECK_FALSE(allNoDelay);
+  CHECK(dist::setNoDelayOnConnectionsTo(servers) == 1);
+  CHECK(pmix.noDelay(pmix.client));
+  CHECK_FALSE(pmix.noDelay(pmix.accepted));
+  CHECK_FALSE(other.noDelay(other.client));  // another peer: untouched
+  CHECK(dist::countConnectionsTo(servers, &allNoDelay) == 1);
+  CHECK(allNoDelay);
+  CHECK(dist::setNoDelayOnConnectionsTo({}) == 0);
 }
 
 TEST_CASE("dist: a round of units is combined on rank 0 in unit order (one process: its own unit)") {

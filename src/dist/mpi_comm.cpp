@@ -16,6 +16,7 @@
 #include <mutex>
 
 #include "dist/comm.h"
+#include "dist/launcher_link.h"
 #include "dist/mpi_backend.h"
 
 namespace tdpm::dist {
@@ -209,6 +210,9 @@ Comm* start(int& argc, char**& argv) {
   preferSharedMemoryOnOneMachine();
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_SERIALIZED, &provided);
+  // MPI_Init connected this rank to the launcher's PMIx server: no Nagle on
+  // that link, or MPI_Finalize sleeps ~40 ms (dist/launcher_link.h).
+  setNoDelayOnConnectionsTo(pmixServerEndpoints());
   gComm = new MpiComm();
   return gComm;
 }

@@ -3,7 +3,8 @@
 // uneven allgather / gather, broadcast from a rank other than 0, integer
 // sums, error agreement, pixel sharing over the tile interleave, and a
 // progressive round combined in rank order with a rank that has no unit,
-// and the kd-tree built by the ranks together equal to one built alone.
+// and the kd-tree built by the ranks together equal to one built alone;
+// and that MPI started with Nagle off on the link to the PMIx server.
 // Prints one line per failed check; exit status 0 when every rank passed.
 #include <cmath>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "dist/comm.h"
+#include "dist/launcher_link.h"
 #include "photon/kdtree.h"
 #include "render/pixel_share.h"
 
@@ -142,6 +144,15 @@ int main(int argc, char** argv) {
               same(alone.zs(), together.zs()) && same(alone.flags(), together.flags()),
           comm, spaceTime ? "4D kd-tree built by the ranks equals the one built alone"
                           : "3D kd-tree built by the ranks equals the one built alone");
+  }
+
+  // Session turned Nagle off on this rank's link to the launcher's PMIx
+  // server (dist/launcher_link.h): under Open MPI's mpirun there is one.
+  {
+    std::vector<dist::TcpEndpoint> servers = dist::pmixServerEndpoints();
+    bool allNoDelay = false;
+    int links = dist::countConnectionsTo(servers, &allNoDelay);
+    if (!servers.empty()) check(links >= 1 && allNoDelay, comm, "TCP_NODELAY on the link to the PMIx server");
   }
 
   uint64_t failed[1] = {uint64_t(failures)};
