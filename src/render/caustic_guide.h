@@ -75,8 +75,25 @@ class CausticGuide {
   // read from one 16-byte record per tree node instead of the store's four
   // arrays: at random places of a 200k-photon guide the k-NN waits on
   // memory, one cache miss per visited node instead of four. Returns count.
-  int nearest(Vec3f p, uint32_t* index, float* dist2) const;
+  int nearest(Vec3f p, uint32_t* index, float* dist2) const { return nearestWithin(p, radius2_, index, dist2); }
   const photon::KdTree& tree() const { return tree_; }
+
+  // The neighbour cache: cells of the occupancy grid cut into
+  // cacheSubdivision()^3 sub-cells; conesAt takes a vertex's photons from
+  // its sub-cell's list (the kNeighbours nearest to the sub-cell's centre
+  // within radius() + the sub-cell's half diagonal, filtered by distance
+  // from the vertex) instead of a k-NN of its own.
+  int cacheSubdivision() const { return cacheSub_; }
+  size_t cacheEntries() const { return cacheCount_.size(); }
+  size_t cacheBytes() const {
+    return cacheIndex_.size() * sizeof(uint32_t) + cacheCount_.size() + occupancy_.cellCount() / 16;
+  }
+  // The photons (tree indices) a vertex at p takes its cones from: the
+  // cache's list, or its own k-NN without a cache. Returns count.
+  int candidates(Vec3f p, uint32_t* index, float* dist2) const;
+  // Sub-cells per occupancy cell and axis for the cache; 0: no cache.
+  static CausticGuide build(const Scene& scene, const CausticGuideSettings& settings, const Progress& progress,
+                            int cacheSubdivision);
 
  private:
   float fraction_ = 0.0f;
@@ -97,6 +114,11 @@ class CausticGuide {
     float oneMinusCos;  // 1 - cos of its cone's half-angle
   };
   std::vector<GuidePhoton> photons_;
+  int nearestWithin(Vec3f p, float r2, uint32_t* index, float* dist2) const;
+  void buildCache(int subdivision);
+  int cacheSub_ = 0;
+  std::vector<uint32_t> cacheIndex_;  // kNeighbours per sub-cell, by occupancy rank then sub-cell
+  std::vector<uint8_t> cacheCount_;
   // Where a vertex cannot find kMinFound photons within the radius: there
   // conesAt skips the k-NN (same result, most vertices are such).
   GuideOccupancy occupancy_;
