@@ -93,6 +93,7 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
   }
   g.photons_.resize(order.size());
   for (size_t i = 0; i < order.size(); ++i) {
+    g.photons_[i].position = g.store_->position(i);
     g.photons_[i].exit = traced.exitPoints[order[i]].point;
     g.photons_[i].normal = traced.exitPoints[order[i]].normal;
   }
@@ -157,13 +158,11 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
 void CausticGuide::buildCache(int sub) {
   cacheSub_ = 0;
   cacheIndex_.clear();
-  cacheCount_.clear();
   if (sub < 1 || !occupancy_.built()) return;
   const std::vector<Vec3f> corners = occupancy_.setCellCorners();
   const size_t per = size_t(sub) * size_t(sub) * size_t(sub);
   const size_t entries = corners.size() * per;
-  cacheIndex_.assign(entries * kNeighbours, 0);
-  cacheCount_.assign(entries, 0);
+  cacheIndex_.assign(entries * kNeighbours, kNoPhoton);
   const float step = occupancy_.cellSize() / float(sub);
   // A photon within the radius of any point of the sub-cell lies within
   // this of its centre (a little more for rounding).
@@ -179,7 +178,6 @@ void CausticGuide::buildCache(int sub) {
                    c.z + (float(j / (size_t(sub) * size_t(sub))) + 0.5f) * step);
       int found = nearestWithin(centre, reach2, index, d2);
       for (int i = 0; i < found; ++i) cacheIndex_[e * kNeighbours + size_t(i)] = index[i];
-      cacheCount_[e] = uint8_t(found);
     }
   });
   cacheSub_ = sub;
@@ -200,8 +198,8 @@ int CausticGuide::candidates(Vec3f p, uint32_t* index, float* dist2) const {
   size_t e = rank * size_t(sub) * size_t(sub) * size_t(sub) + size_t((jz * sub + jy) * sub + jx);
   const uint32_t* cached = &cacheIndex_[e * kNeighbours];
   int found = 0;
-  for (int i = 0, n = cacheCount_[e]; i < n; ++i) {
-    const Node& q = nodes_[cached[i]];
+  for (int i = 0; i < kNeighbours && cached[i] != kNoPhoton; ++i) {
+    const Vec3f q = photons_[cached[i]].position;
     float dx = q.x - p.x, dy = q.y - p.y, dz = q.z - p.z;
     float d = dx * dx + dy * dy + dz * dz;
     if (d < radius2_) {

@@ -84,10 +84,8 @@ class CausticGuide {
   // within radius() + the sub-cell's half diagonal, filtered by distance
   // from the vertex) instead of a k-NN of its own.
   int cacheSubdivision() const { return cacheSub_; }
-  size_t cacheEntries() const { return cacheCount_.size(); }
-  size_t cacheBytes() const {
-    return cacheIndex_.size() * sizeof(uint32_t) + cacheCount_.size() + occupancy_.cellCount() / 16;
-  }
+  size_t cacheEntries() const { return cacheIndex_.size() / kNeighbours; }
+  size_t cacheBytes() const { return cacheIndex_.size() * sizeof(uint32_t) + occupancy_.cellCount() / 16; }
   // The photons (tree indices) a vertex at p takes its cones from: the
   // cache's list, or its own k-NN without a cache. Returns count.
   int candidates(Vec3f p, uint32_t* index, float* dist2) const;
@@ -109,6 +107,7 @@ class CausticGuide {
   // What a vertex reads of each of its photons, in one record (one cache
   // line fetch per photon), in the tree's order.
   struct GuidePhoton {
+    Vec3f position;     // where it was stored (the cache's distance test)
     Vec3f exit;         // last specular vertex
     Vec3f normal;       // of the surface it was stored on, facing its arrival
     float oneMinusCos;  // 1 - cos of its cone's half-angle
@@ -117,8 +116,10 @@ class CausticGuide {
   int nearestWithin(Vec3f p, float r2, uint32_t* index, float* dist2) const;
   void buildCache(int subdivision);
   int cacheSub_ = 0;
-  std::vector<uint32_t> cacheIndex_;  // kNeighbours per sub-cell, by occupancy rank then sub-cell
-  std::vector<uint8_t> cacheCount_;
+  // kNeighbours per sub-cell (one 32-byte record), by occupancy rank then
+  // sub-cell; kNoPhoton after the last.
+  static constexpr uint32_t kNoPhoton = 0xffffffffu;
+  std::vector<uint32_t> cacheIndex_;
   // Where a vertex cannot find kMinFound photons within the radius: there
   // conesAt skips the k-NN (same result, most vertices are such).
   GuideOccupancy occupancy_;
