@@ -26,7 +26,7 @@
 // share of the mixture falls. An occupancy grid (render/guide_occupancy.h)
 // answers for the many vertices with no photon near; elsewhere a vertex's
 // photons come from its grid sub-cell's list of 8, cached before the first
-// pixel (a k-NN per vertex cost ~0.2x of an unguided path's instructions;
+// pixel (a k-NN per vertex cost 0.14-0.24x of an unguided path's instructions;
 // the cones still aim from the vertex itself, docs/sampling.md). The
 // guide is a fixed function of the scene and the seed,
 // built before any pixel by every process alike, so images stay identical
