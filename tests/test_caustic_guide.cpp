@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <vector>
 
 #include "core/rng.h"
 #include "math/frame.h"
@@ -282,6 +283,93 @@ TEST_CASE("caustic guide: its compact k-NN returns what the kd-tree's k-NN retur
   CHECK(differ == 0);
   CHECK(full > 2000);
   CHECK(some > 500);
+}
+
+TEST_CASE("caustic guide: the neighbour cache gives a vertex only photons within its radius, from one list per sub-cell") {
+  // conesAt takes a vertex's photons from its occupancy sub-cell's cached
+  // list (the 8 nearest to the sub-cell's centre), kept when within the
+  // radius of the vertex itself. Checked against the per-vertex k-NN of a
+  // guide without the cache (same photons): every candidate is within the
+  // radius at its true distance, none twice, and where the vertex has fewer
+  // than 8 photons within the radius the candidates are a subset of them
+  // (most often all of them); and two points of one sub-cell draw on one
+  // list: each one's candidates within the other's radius are the same, in
+  // the same order (a cache filled by whichever vertex came first fails it).
+  auto s = Scene::build(cubeCaustic(40, 30, 1.0f));
+  CausticGuideSettings gs;
+  gs.fraction = 0.5f;
+  gs.photons = 30000;
+  gs.seed = 5;
+  CausticGuide cached = CausticGuide::build(*s, gs, Progress{});
+  CausticGuide plain = CausticGuide::build(*s, gs, Progress{}, 0);
+  REQUIRE(cached.enabled());
+  REQUIRE(cached.cacheSubdivision() >= 1);
+  REQUIRE(plain.cacheSubdivision() == 0);
+  REQUIRE(cached.photonCount() == plain.photonCount());
+  const float r2 = cached.radius() * cached.radius();
+  const float step = cached.occupancy().cellSize() / float(cached.cacheSubdivision());
+  auto positionOf = [&](uint32_t i) { return cached.tree().store().position(i); };
+  auto subCell = [&](Vec3f p, size_t& rank, int& sub) {
+    Vec3f local;
+    if (!cached.occupancy().locate(p, rank, local)) return false;
+    int n = cached.cacheSubdivision();
+    sub = (std::min(n - 1, int(local.z * float(n))) * n + std::min(n - 1, int(local.y * float(n)))) * n +
+          std::min(n - 1, int(local.x * float(n)));
+    return true;
+  };
+  Rng rng(13);
+  int bad = 0, notSubset = 0, sparse = 0, sparseEqual = 0, pairs = 0, pairsDiffer = 0, nonEmpty = 0;
+  for (int i = 0; i < 20000; ++i) {
+    Vec3f p = i % 2 == 0 ? positionOf(uint32_t(size_t(rng.uniform() * float(cached.photonCount())) % cached.photonCount())) +
+                               Vec3f{0.05f * (rng.uniform() - 0.5f), 0.01f * rng.uniform(), 0.05f * (rng.uniform() - 0.5f)}
+                         : Vec3f{-3.0f + 6.0f * rng.uniform(), 2.5f * rng.uniform(), -2.5f + 5.0f * rng.uniform()};
+    uint32_t a[CausticGuide::kNeighbours + 1], b[CausticGuide::kNeighbours + 1];
+    float da[CausticGuide::kNeighbours + 1], db[CausticGuide::kNeighbours + 1];
+    int na = cached.candidates(p, a, da);
+    nonEmpty += na > 0;
+    for (int j = 0; j < na; ++j) {
+      Vec3f d = positionOf(a[j]) - p;
+      bool ok = da[j] < r2 && std::fabs(da[j] - lengthSquared(d)) <= 1e-6f * r2;
+      for (int k = 0; k < j; ++k) ok = ok && a[k] != a[j];
+      bad += !ok;
+    }
+    int nb = plain.nearest(p, b, db);
+    if (nb < CausticGuide::kNeighbours) {  // b holds every photon within the radius
+      ++sparse;
+      bool subset = true;
+      for (int j = 0; j < na; ++j) {
+        bool in = false;
+        for (int k = 0; k < nb; ++k) in = in || a[j] == b[k];
+        subset = subset && in;
+      }
+      notSubset += !subset;
+      sparseEqual += subset && na == nb;
+    }
+    // A second point of the same sub-cell.
+    Vec3f q = p + Vec3f{0.3f * step * (rng.uniform() - 0.5f), 0.3f * step * (rng.uniform() - 0.5f),
+                        0.3f * step * (rng.uniform() - 0.5f)};
+    size_t rp, rq;
+    int sp, sq;
+    if (!subCell(p, rp, sp) || !subCell(q, rq, sq) || rp != rq || sp != sq) continue;
+    int nq = cached.candidates(q, b, db);
+    std::vector<uint32_t> fromP, fromQ;
+    for (int j = 0; j < na; ++j)
+      if (lengthSquared(positionOf(a[j]) - q) < r2) fromP.push_back(a[j]);
+    for (int j = 0; j < nq; ++j)
+      if (lengthSquared(positionOf(b[j]) - p) < r2) fromQ.push_back(b[j]);
+    ++pairs;
+    pairsDiffer += fromP != fromQ;
+  }
+  MESSAGE("cache: " << cached.cacheEntries() << " sub-cells, " << cached.cacheBytes() << " bytes; points with candidates "
+                    << nonEmpty << ", with < 8 within the radius " << sparse << " (candidates all of them: " << sparseEqual
+                    << "), same-sub-cell pairs " << pairs);
+  CHECK(bad == 0);
+  CHECK(notSubset == 0);
+  CHECK(nonEmpty > 5000);
+  CHECK(sparse > 500);
+  CHECK(sparseEqual > sparse / 2);
+  CHECK(pairs > 5000);
+  CHECK(pairsDiffer == 0);
 }
 
 TEST_CASE("caustic guide: guided and unguided path tracing agree in mean, on the image and on the caustic") {

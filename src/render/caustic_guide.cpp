@@ -7,6 +7,9 @@
 #include <limits>
 #include <cstdlib>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "core/rng.h"
 #include "photon/tracer.h"
 
@@ -39,6 +42,10 @@ constexpr float kRadiusScale = 4.0f;
 // (r0 / distance)^2, to c/16 at the search radius.
 constexpr float kTrustRadiusScale = 1.0f;
 
+// Sub-cells per occupancy cell and axis of the neighbour cache (0: a k-NN
+// per vertex).
+constexpr int kCacheSubdivision = 2;
+
 const float kMaxOneMinusCos = 2.0f * std::sin(0.5f * kMaxHalfAngle) * std::sin(0.5f * kMaxHalfAngle);
 
 // The upper median of v[0..n) (n <= kNeighbours), by insertion sort.
@@ -55,6 +62,11 @@ bool diffuseLike(const Material& m) {
 }  // namespace
 
 CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings& s, const Progress& progress) {
+  return build(scene, s, progress, kCacheSubdivision);
+}
+
+CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings& s, const Progress& progress,
+                                 int cacheSubdivision) {
   CausticGuide g;
   if (!(s.fraction > 0.0f) || s.photons == 0 || !photon::sceneHasSpecular(scene, false)) return g;
   photon::TraceSettings t;
@@ -81,6 +93,7 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
   }
   g.photons_.resize(order.size());
   for (size_t i = 0; i < order.size(); ++i) {
+    g.photons_[i].position = g.store_->position(i);
     g.photons_[i].exit = traced.exitPoints[order[i]].point;
     g.photons_[i].normal = traced.exitPoints[order[i]].normal;
   }
@@ -138,16 +151,72 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
   for (size_t i = 0; i < positions.size(); ++i) positions[i] = g.store_->position(i);
   g.occupancy_ = GuideOccupancy::build(positions, radius, kMinFound);
   g.fraction_ = s.fraction;
+  g.buildCache(cacheSubdivision);
   return g;
+}
+
+void CausticGuide::buildCache(int sub) {
+  cacheSub_ = 0;
+  cacheIndex_.clear();
+  if (sub < 1 || !occupancy_.built()) return;
+  const std::vector<Vec3f> corners = occupancy_.setCellCorners();
+  const size_t per = size_t(sub) * size_t(sub) * size_t(sub);
+  const size_t entries = corners.size() * per;
+  cacheIndex_.assign(entries * kNeighbours, kNoPhoton);
+  const float step = occupancy_.cellSize() / float(sub);
+  // A photon within the radius of any point of the sub-cell lies within
+  // this of its centre (a little more for rounding).
+  const float reach = (std::sqrt(radius2_) + 0.5f * std::sqrt(3.0f) * step) * 1.0001f;
+  const float reach2 = reach * reach;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, entries, 256), [&](const tbb::blocked_range<size_t>& range) {
+    uint32_t index[kNeighbours + 1];
+    float d2[kNeighbours + 1];
+    for (size_t e = range.begin(); e != range.end(); ++e) {
+      size_t j = e % per;
+      Vec3f c = corners[e / per];
+      Vec3f centre(c.x + (float(j % size_t(sub)) + 0.5f) * step, c.y + (float((j / size_t(sub)) % size_t(sub)) + 0.5f) * step,
+                   c.z + (float(j / (size_t(sub) * size_t(sub))) + 0.5f) * step);
+      int found = nearestWithin(centre, reach2, index, d2);
+      for (int i = 0; i < found; ++i) cacheIndex_[e * kNeighbours + size_t(i)] = index[i];
+    }
+  });
+  cacheSub_ = sub;
+}
+
+int CausticGuide::candidates(Vec3f p, uint32_t* index, float* dist2) const {
+  if (cacheSub_ == 0) {
+    if (!occupancy_.mayHaveNear(p)) return 0;  // the k-NN would find < kMinFound
+    return nearest(p, index, dist2);
+  }
+  size_t rank;
+  Vec3f local;
+  if (!occupancy_.locate(p, rank, local)) return 0;
+  const int sub = cacheSub_;
+  int jx = std::min(sub - 1, int(local.x * float(sub)));
+  int jy = std::min(sub - 1, int(local.y * float(sub)));
+  int jz = std::min(sub - 1, int(local.z * float(sub)));
+  size_t e = rank * size_t(sub) * size_t(sub) * size_t(sub) + size_t((jz * sub + jy) * sub + jx);
+  const uint32_t* cached = &cacheIndex_[e * kNeighbours];
+  int found = 0;
+  for (int i = 0; i < kNeighbours && cached[i] != kNoPhoton; ++i) {
+    const Vec3f q = photons_[cached[i]].position;
+    float dx = q.x - p.x, dy = q.y - p.y, dz = q.z - p.z;
+    float d = dx * dx + dy * dy + dz * dz;
+    if (d < radius2_) {
+      index[found] = cached[i];
+      dist2[found++] = d;
+    }
+  }
+  return found;
 }
 
 // photon::KdTree::knnImpl<3> for k = kNeighbours over nodes_: the same
 // descent, deferral, heap and tests in the same order (kept in step with
 // it; tests/test_caustic_guide.cpp compares the two on random queries).
-int CausticGuide::nearest(Vec3f p, uint32_t* idx, float* d2) const {
+int CausticGuide::nearestWithin(Vec3f p, float radius2, uint32_t* idx, float* d2) const {
   constexpr int k = kNeighbours;
   const uint32_t n = uint32_t(nodes_.size());
-  if (n == 0 || !(radius2_ > 0.0f)) return 0;
+  if (n == 0 || !(radius2 > 0.0f)) return 0;
   const Node* N = nodes_.data();
   const float key[3] = {p.x, p.y, p.z};
   struct Deferred {
@@ -156,7 +225,7 @@ int CausticGuide::nearest(Vec3f p, uint32_t* idx, float* d2) const {
     float offset[3];
   };
   Deferred stack[64];  // one per level at most; the tree is < 32 levels deep
-  float r2 = radius2_;
+  float r2 = radius2;
   int count = 0, sp = 0;
   float off[3] = {0.0f, 0.0f, 0.0f};
   float cellDist2 = 0.0f;
@@ -246,10 +315,9 @@ void CausticGuide::conesAt(const Material& m, Vec3f p, Vec3f n, GuideCones& out)
   out.totalSolidAngle = 0.0f;
   out.fraction = 0.0f;
   if (!enabled() || !diffuseLike(m)) return;
-  if (!occupancy_.mayHaveNear(p)) return;  // the k-NN would find < kMinFound
   uint32_t index[kNeighbours + 1];
   float d2[kNeighbours + 1];
-  int found = nearest(p, index, d2);
+  int found = candidates(p, index, d2);
   if (found < kMinFound) return;
   Vec3f axis[kNeighbours];
   float omc[kNeighbours], dist2[kNeighbours];

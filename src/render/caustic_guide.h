@@ -24,7 +24,10 @@
 // BSDF sampling by render/guided_sampling.h, which keeps the estimate
 // unbiased whatever the guide holds. Where the photons are far, the guide's
 // share of the mixture falls. An occupancy grid (render/guide_occupancy.h)
-// answers, without the k-NN, for the many vertices with no photon near. The
+// answers for the many vertices with no photon near; elsewhere a vertex's
+// photons come from its grid sub-cell's list of 8, cached before the first
+// pixel (a k-NN per vertex cost 0.14-0.24x of an unguided path's instructions;
+// the cones still aim from the vertex itself, docs/sampling.md). The
 // guide is a fixed function of the scene and the seed,
 // built before any pixel by every process alike, so images stay identical
 // across threads and MPI ranks.
@@ -75,8 +78,23 @@ class CausticGuide {
   // read from one 16-byte record per tree node instead of the store's four
   // arrays: at random places of a 200k-photon guide the k-NN waits on
   // memory, one cache miss per visited node instead of four. Returns count.
-  int nearest(Vec3f p, uint32_t* index, float* dist2) const;
+  int nearest(Vec3f p, uint32_t* index, float* dist2) const { return nearestWithin(p, radius2_, index, dist2); }
   const photon::KdTree& tree() const { return tree_; }
+
+  // The neighbour cache: cells of the occupancy grid cut into
+  // cacheSubdivision()^3 sub-cells; conesAt takes a vertex's photons from
+  // its sub-cell's list (the kNeighbours nearest to the sub-cell's centre
+  // within radius() + the sub-cell's half diagonal, filtered by distance
+  // from the vertex) instead of a k-NN of its own.
+  int cacheSubdivision() const { return cacheSub_; }
+  size_t cacheEntries() const { return cacheIndex_.size() / kNeighbours; }
+  size_t cacheBytes() const { return cacheIndex_.size() * sizeof(uint32_t) + occupancy_.cellCount() / 16; }
+  // The photons (tree indices) a vertex at p takes its cones from: the
+  // cache's list, or its own k-NN without a cache. Returns count.
+  int candidates(Vec3f p, uint32_t* index, float* dist2) const;
+  // Sub-cells per occupancy cell and axis for the cache; 0: no cache.
+  static CausticGuide build(const Scene& scene, const CausticGuideSettings& settings, const Progress& progress,
+                            int cacheSubdivision);
 
  private:
   float fraction_ = 0.0f;
@@ -92,11 +110,19 @@ class CausticGuide {
   // What a vertex reads of each of its photons, in one record (one cache
   // line fetch per photon), in the tree's order.
   struct GuidePhoton {
+    Vec3f position;     // where it was stored (the cache's distance test)
     Vec3f exit;         // last specular vertex
     Vec3f normal;       // of the surface it was stored on, facing its arrival
     float oneMinusCos;  // 1 - cos of its cone's half-angle
   };
   std::vector<GuidePhoton> photons_;
+  int nearestWithin(Vec3f p, float r2, uint32_t* index, float* dist2) const;
+  void buildCache(int subdivision);
+  int cacheSub_ = 0;
+  // kNeighbours per sub-cell (one 32-byte record), by occupancy rank then
+  // sub-cell; kNoPhoton after the last.
+  static constexpr uint32_t kNoPhoton = 0xffffffffu;
+  std::vector<uint32_t> cacheIndex_;
   // Where a vertex cannot find kMinFound photons within the radius: there
   // conesAt skips the k-NN (same result, most vertices are such).
   GuideOccupancy occupancy_;

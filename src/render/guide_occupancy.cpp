@@ -84,6 +84,12 @@ GuideOccupancy GuideOccupancy::build(const std::vector<Vec3f>& points, float rad
   g.bits_.assign((count.size() + 63) / 64, 0);
   for (size_t i = 0; i < count.size(); ++i)
     if (count[i] >= minCount) g.bits_[i >> 6] |= uint64_t(1) << (i & 63);
+  g.rank_.resize(g.bits_.size());
+  uint32_t before = 0;
+  for (size_t w = 0; w < g.bits_.size(); ++w) {
+    g.rank_[w] = before;
+    before += uint32_t(__builtin_popcountll(g.bits_[w]));
+  }
   g.built_ = true;
   return g;
 }
@@ -92,6 +98,20 @@ size_t GuideOccupancy::setCount() const {
   size_t s = 0;
   for (uint64_t w : bits_) s += size_t(__builtin_popcountll(w));
   return s;
+}
+
+std::vector<Vec3f> GuideOccupancy::setCellCorners() const {
+  std::vector<Vec3f> corners;
+  if (!built_) return corners;
+  corners.reserve(setCount());
+  for (int z = 0; z < nz_; ++z)
+    for (int y = 0; y < ny_; ++y)
+      for (int x = 0; x < nx_; ++x) {
+        size_t c = cellIndex(x, y, z);
+        if ((bits_[c >> 6] >> (c & 63)) & 1u)
+          corners.push_back(Vec3f(lo_.x + float(x) * cell_, lo_.y + float(y) * cell_, lo_.z + float(z) * cell_));
+      }
+  return corners;
 }
 
 }  // namespace tdpm

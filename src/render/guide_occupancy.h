@@ -42,6 +42,25 @@ class GuideOccupancy {
     return (bits_[c >> 6] >> (c & 63)) & 1u;
   }
 
+  // For a cache keyed by set cells (render/caustic_guide.h): false as
+  // mayHaveNear; else the rank of p's cell among the set cells (in cell
+  // index order) and p's place inside the cell, in [0, 1] per axis.
+  bool locate(Vec3f p, size_t& rank, Vec3f& local) const {
+    if (!built_) return false;
+    float fx = (p.x - lo_.x) * invCell_, fy = (p.y - lo_.y) * invCell_, fz = (p.z - lo_.z) * invCell_;
+    if (!(fx >= 0.0f && fy >= 0.0f && fz >= 0.0f && fx < float(nx_) && fy < float(ny_) && fz < float(nz_)))
+      return false;
+    int ix = int(fx), iy = int(fy), iz = int(fz);
+    size_t c = cellIndex(ix, iy, iz);
+    uint64_t word = bits_[c >> 6], below = (uint64_t(1) << (c & 63)) - 1;
+    if (!((word >> (c & 63)) & 1u)) return false;
+    rank = size_t(rank_[c >> 6]) + size_t(__builtin_popcountll(word & below));
+    local = Vec3f(fx - float(ix), fy - float(iy), fz - float(iz));
+    return true;
+  }
+  // The set cells' lower corners, in rank order.
+  std::vector<Vec3f> setCellCorners() const;
+
   bool built() const { return built_; }
   float cellSize() const { return cell_; }
   size_t cellCount() const { return size_t(nx_) * size_t(ny_) * size_t(nz_); }
@@ -55,6 +74,7 @@ class GuideOccupancy {
   float cell_ = 0.0f, invCell_ = 0.0f;
   int nx_ = 0, ny_ = 0, nz_ = 0;
   std::vector<uint64_t> bits_;
+  std::vector<uint32_t> rank_;  // set bits in the words before each word
 };
 
 }  // namespace tdpm
