@@ -41,6 +41,37 @@ scene::SceneDescription metalFloorUnderCeiling() {
   return d;
 }
 
+// Pixels whose centre sees `object` at mid-shutter.
+std::vector<size_t> pixelsSeeing(const Scene& s, uint32_t object) {
+  std::vector<size_t> pixels;
+  const int w = s.camera.width(), h = s.camera.height();
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      Vec3f o, dir;
+      s.camera.generateRay({x + 0.5f, y + 0.5f}, 0.5f, o, dir);
+      Hit hit;
+      if (s.intersect(o, dir, 1e30f, 0.5f, hit) && hit.object == object) pixels.push_back(size_t(y) * w + x);
+    }
+  return pixels;
+}
+
+// Mean over `pixels` of a render with 200k caustic and 20k global photons.
+double renderMean(const Scene& s, const std::vector<size_t>& pixels, const std::string& method, int spp,
+                  uint64_t seed) {
+  RenderOptions o;
+  o.method = method;
+  o.spp = spp;
+  o.seed = seed;
+  o.causticPhotons = 200000;
+  o.globalPhotons = 20000;
+  o.estimate.k = 100;
+  RenderStats st;
+  Film f = render(s, o, Progress{}, st);
+  double sum = 0;
+  for (size_t i : pixels) sum += f.color[i].average();
+  return sum / double(pixels.size());
+}
+
 }  // namespace
 
 TEST_CASE("glossy caustics: a sharp metal is a caustic generator, a rough one is not") {
@@ -70,30 +101,9 @@ TEST_CASE("glossy caustics: a sharp metal is a caustic generator, a rough one is
 
 TEST_CASE("glossy caustics: the photon methods match the path tracer on a ceiling lit through a sharp metal") {
   auto s = Scene::build(metalFloorUnderCeiling());
-  const int w = s->camera.width(), h = s->camera.height();
-  std::vector<size_t> ceiling;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      Vec3f o, dir;
-      s->camera.generateRay({x + 0.5f, y + 0.5f}, 0.5f, o, dir);
-      Hit hit;
-      if (s->intersect(o, dir, 1e30f, 0.5f, hit) && hit.object == kCeiling) ceiling.push_back(size_t(y) * w + x);
-    }
+  std::vector<size_t> ceiling = pixelsSeeing(*s, kCeiling);
   REQUIRE(ceiling.size() > 200);
-  auto mean = [&](const std::string& method, int spp) {
-    RenderOptions o;
-    o.method = method;
-    o.spp = spp;
-    o.seed = 5;
-    o.causticPhotons = 200000;
-    o.globalPhotons = 20000;
-    o.estimate.k = 100;
-    RenderStats st;
-    Film f = render(*s, o, Progress{}, st);
-    double sum = 0;
-    for (size_t i : ceiling) sum += f.color[i].average();
-    return sum / double(ceiling.size());
-  };
+  auto mean = [&](const std::string& method, int spp) { return renderMean(*s, ceiling, method, spp, 5); };
   double ref = mean("pathtrace", 512);
   double standard = mean("standard", 16);
   double time = mean("time", 16);
@@ -115,30 +125,9 @@ TEST_CASE("glossy caustics: the eye path passes through a sharp metal and matche
   d.camera.target = {0, 0, 0};
   d.camera.fovDegrees = 50;
   auto s = Scene::build(d);
-  const int w = s->camera.width(), h = s->camera.height();
-  std::vector<size_t> metal;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      Vec3f o, dir;
-      s->camera.generateRay({x + 0.5f, y + 0.5f}, 0.5f, o, dir);
-      Hit hit;
-      if (s->intersect(o, dir, 1e30f, 0.5f, hit) && hit.object == kMetalFloor) metal.push_back(size_t(y) * w + x);
-    }
+  std::vector<size_t> metal = pixelsSeeing(*s, kMetalFloor);
   REQUIRE(metal.size() > 200);
-  auto mean = [&](const std::string& method, int spp) {
-    RenderOptions o;
-    o.method = method;
-    o.spp = spp;
-    o.seed = 7;
-    o.causticPhotons = 200000;
-    o.globalPhotons = 20000;
-    o.estimate.k = 100;
-    RenderStats st;
-    Film f = render(*s, o, Progress{}, st);
-    double sum = 0;
-    for (size_t i : metal) sum += f.color[i].average();
-    return sum / double(metal.size());
-  };
+  auto mean = [&](const std::string& method, int spp) { return renderMean(*s, metal, method, spp, 7); };
   double ref = mean("pathtrace", 512);
   double standard = mean("standard", 32);
   MESSAGE("metal floor mean: pathtrace " << ref << ", standard " << standard << " (" << standard / ref << ")");

@@ -14,6 +14,7 @@
 
 #include "core/error.h"
 #include "dist/comm.h"
+#include "photon/knn_heap.h"
 
 namespace tdpm::photon {
 
@@ -282,34 +283,7 @@ double KdTree::bytesPerPhoton() const {
   return store_->bytesPerPhoton();
 }
 
-// ---- k-nearest-neighbour search ----
-
-namespace {
-
-// Max-heap on dist2 (root = the farthest candidate), index carried along.
-// The choice between the two children is branch-free: it is a coin flip for
-// the branch predictor, and sifting is a large part of the k-NN's time.
-// (A 4-ary heap measured slower here.) d2[n] must hold -infinity (a
-// sentinel right child for the last left child, never chosen).
-inline void siftDown(float* d2, uint32_t* idx, int n, int i) {
-  float d = d2[i];
-  uint32_t v = idx[i];
-  for (;;) {
-    int c = 2 * i + 1;
-    if (c >= n) break;
-    c += int(d2[c + 1] > d2[c]);
-    float dc = d2[c];
-    if (dc <= d) break;
-    d2[i] = dc;
-    idx[i] = idx[c];
-    i = c;
-  }
-  d2[i] = d;
-  idx[i] = v;
-}
-constexpr int kHeapPad = 1;
-
-}  // namespace
+// ---- k-nearest-neighbour search (heap: photon/knn_heap.h) ----
 
 template <int D>
 int KdTree::knnImpl(const float* key, int k, float maxRadius2, KnnQuery& q) const {
@@ -341,22 +315,7 @@ int KdTree::knnImpl(const float* key, int k, float maxRadius2, KnnQuery& q) cons
       float dt = timeBase_ + float(F[p] & kTimeMask) * timeStep_ - kt;
       dist += dt * dt;
     }
-    if (dist < r2) {
-      if (count < k) {
-        idx[count] = p;
-        d2[count] = dist;
-        if (++count == k) {
-          for (int i = 0; i < kHeapPad; ++i) d2[k + i] = -std::numeric_limits<float>::infinity();
-          for (int i = k / 2 - 1; i >= 0; --i) siftDown(d2, idx, k, i);
-          r2 = d2[0];
-        }
-      } else {
-        d2[0] = dist;
-        idx[0] = p;
-        siftDown(d2, idx, k, 0);
-        r2 = d2[0];
-      }
-    }
+    if (dist < r2) knnOffer(d2, idx, k, count, r2, p, dist);
   };
 
   uint32_t node = 0;

@@ -11,6 +11,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/rng.h"
+#include "photon/knn_heap.h"
 #include "photon/tracer.h"
 
 namespace tdpm {
@@ -229,41 +230,10 @@ int CausticGuide::nearestWithin(Vec3f p, float radius2, uint32_t* idx, float* d2
   int count = 0, sp = 0;
   float off[3] = {0.0f, 0.0f, 0.0f};
   float cellDist2 = 0.0f;
-  auto siftDown = [&](int i) {
-    float d = d2[i];
-    uint32_t v = idx[i];
-    for (;;) {
-      int c = 2 * i + 1;
-      if (c >= k) break;
-      c += int(d2[c + 1] > d2[c]);
-      float dc = d2[c];
-      if (dc <= d) break;
-      d2[i] = dc;
-      idx[i] = idx[c];
-      i = c;
-    }
-    d2[i] = d;
-    idx[i] = v;
-  };
   auto test = [&](uint32_t q) {
     float dx = N[q].x - key[0], dy = N[q].y - key[1], dz = N[q].z - key[2];
     float dist = dx * dx + dy * dy + dz * dz;
-    if (dist < r2) {
-      if (count < k) {
-        idx[count] = q;
-        d2[count] = dist;
-        if (++count == k) {
-          d2[k] = -std::numeric_limits<float>::infinity();
-          for (int i = k / 2 - 1; i >= 0; --i) siftDown(i);
-          r2 = d2[0];
-        }
-      } else {
-        d2[0] = dist;
-        idx[0] = q;
-        siftDown(0);
-        r2 = d2[0];
-      }
-    }
+    if (dist < r2) photon::knnOffer(d2, idx, k, count, r2, q, dist);
   };
   uint32_t node = 0;
   for (;;) {
