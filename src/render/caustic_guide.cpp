@@ -224,22 +224,34 @@ void CausticGuide::orderRecords() {
     treeOfRecord_[r] = t;
     recordOfTree_[t] = uint32_t(r);
   }
-  photons_ = std::move(records);
+  photons_.clear();
+  photons_.shrink_to_fit();
+  photonCount_ = n;
+  recordMemory_ = HugePageBuffer(n * sizeof(GuidePhoton));
+  if (recordMemory_.data()) {
+    GuidePhoton* out = static_cast<GuidePhoton*>(recordMemory_.data());
+    std::copy(records.begin(), records.end(), out);
+    records_ = out;
+  } else {
+    photons_ = std::move(records);  // no mapping: the vector's memory
+    records_ = photons_.data();
+  }
 }
 
 void CausticGuide::allocateCache(int sub) {
   cacheSub_ = 0;
   cacheEntries_ = 0;
-  cache_.reset();
+  cache_ = nullptr;
+  cacheMemory_ = HugePageBuffer();
   if (sub < 1 || !occupancy_.built()) return;
   const size_t entries = occupancy_.setCount() * size_t(sub) * size_t(sub) * size_t(sub);
   if (entries == 0) return;
-  // calloc: the system's zeroed pages, mapped only where a list is filled.
-  void* mem = std::calloc(entries * kNeighbours, sizeof(std::atomic<uint32_t>));
-  if (!mem) return;  // no cache: a k-NN per vertex, same cones
+  // Zeroed memory from the system (huge pages: core/huge_pages.h).
+  cacheMemory_ = HugePageBuffer(entries * kNeighbours * sizeof(std::atomic<uint32_t>));
+  if (!cacheMemory_.data()) return;  // no cache: a k-NN per vertex, same cones
   static_assert(sizeof(std::atomic<uint32_t>) == sizeof(uint32_t) && std::atomic<uint32_t>::is_always_lock_free,
                 "slots are plain 32-bit words");
-  cache_.reset(static_cast<std::atomic<uint32_t>*>(mem));
+  cache_ = static_cast<std::atomic<uint32_t>*>(cacheMemory_.data());
   cacheEntries_ = entries;
   // A photon within the radius of any point of the sub-cell lies within
   // this of its centre (a little more for rounding).
@@ -306,7 +318,7 @@ int CausticGuide::candidates(Vec3f p, uint32_t* index, float* dist2) const {
   // waited for the previous photon's load).
   float d[kNeighbours];
   for (int i = 0; i < n; ++i) {
-    const Vec3f q = photons_[list[i]].position;
+    const Vec3f q = records_[list[i]].position;
     float dx = q.x - p.x, dy = q.y - p.y, dz = q.z - p.z;
     d[i] = dx * dx + dy * dy + dz * dz;
   }
@@ -406,7 +418,7 @@ void CausticGuide::conesAt(const Material& m, Vec3f p, Vec3f n, GuideCones& out)
   Vec3f dir[kNeighbours];
   bool keep[kNeighbours];
   for (int i = 0; i < found; ++i) {
-    const GuidePhoton& o = photons_[index[i]];
+    const GuidePhoton& o = records_[index[i]];
     Vec3f d = o.exit - p;
     d = d * (1.0f / length(d));
     dir[i] = d;
@@ -416,7 +428,7 @@ void CausticGuide::conesAt(const Material& m, Vec3f p, Vec3f n, GuideCones& out)
   float omc[kNeighbours], dist2[kNeighbours];
   int count = 0;
   for (int i = 0; i < found; ++i) {
-    omc[count] = photons_[index[i]].oneMinusCos;
+    omc[count] = records_[index[i]].oneMinusCos;
     dist2[count] = d2[i];
     axis[count] = dir[i];
     count += keep[i];

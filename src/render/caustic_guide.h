@@ -39,6 +39,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/huge_pages.h"
 #include "core/progress.h"
 #include "photon/kdtree.h"
 #include "photon/store.h"
@@ -66,7 +67,7 @@ class CausticGuide {
   static CausticGuide build(const Scene& scene, const CausticGuideSettings& settings, const Progress& progress);
 
   bool enabled() const { return fraction_ > 0.0f; }
-  size_t photonCount() const { return photons_.size(); }
+  size_t photonCount() const { return photonCount_; }
   uint64_t photonsEmitted() const { return emitted_; }  // paths traced for the guide
   float radius() const { return std::sqrt(radius2_); }
   const GuideOccupancy& occupancy() const { return occupancy_; }
@@ -91,8 +92,7 @@ class CausticGuide {
   // within radius() + the sub-cell's half diagonal, filtered by distance
   // from the vertex) instead of a k-NN of its own. A list is filled the
   // first time a vertex lands in its sub-cell (most sub-cells lie off every
-  // surface and are never asked for); the array is zeroed pages from the
-  // system, so only the filled ones take memory.
+  // surface and are never asked for), into zeroed memory from the system.
   int cacheSubdivision() const { return cacheSub_; }
   size_t cacheEntries() const { return cacheEntries_; }
   // Bytes reserved (address space; resident only where filled).
@@ -100,7 +100,7 @@ class CausticGuide {
   size_t cacheFilled() const;  // sub-cells whose list has been filled (a scan: for stats and tests)
   // Bytes of the photon records and tree nodes kept for rendering.
   size_t photonBytes() const {
-    return photons_.size() * (sizeof(GuidePhoton) + 2 * sizeof(uint32_t)) + nodes_.size() * sizeof(Node) +
+    return photonCount_ * (sizeof(GuidePhoton) + 2 * sizeof(uint32_t)) + nodes_.size() * sizeof(Node) +
            (store_ ? store_->bytesAllocated() : 0);
   }
   // The photons a vertex at p takes its cones from, as record indices
@@ -139,7 +139,11 @@ class CausticGuide {
   };
   static_assert(sizeof(GuidePhoton) == 32, "one guide photon record is 32 bytes");
   // In Morton order of position (orderRecords), not the tree's.
+  // photons_ while building; then records_, on huge pages (core/huge_pages.h).
   std::vector<GuidePhoton> photons_;
+  HugePageBuffer recordMemory_;
+  const GuidePhoton* records_ = nullptr;
+  size_t photonCount_ = 0;
   std::vector<uint32_t> treeOfRecord_, recordOfTree_;
   void orderRecords();
   int nearestWithin(Vec3f p, float r2, uint32_t* index, float* dist2) const;
@@ -156,10 +160,8 @@ class CausticGuide {
   // so a reader sees a whole list or none; two threads filling one list
   // write the same values.
   static constexpr uint32_t kFilledEmpty = 0xffffffffu;
-  struct FreeDeleter {
-    void operator()(std::atomic<uint32_t>* p) const { std::free(p); }
-  };
-  std::unique_ptr<std::atomic<uint32_t>[], FreeDeleter> cache_;
+  HugePageBuffer cacheMemory_;
+  std::atomic<uint32_t>* cache_ = nullptr;
   size_t cacheEntries_ = 0;
   // Where a vertex cannot find kMinFound photons within the radius: there
   // conesAt skips the k-NN (same result, most vertices are such).
