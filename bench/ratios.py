@@ -5,6 +5,8 @@
 # (name, numerator, denominator, better, target, what)
 #   ratio = time(numerator) / time(denominator), or for "rate" ratios
 #   rate(numerator) / rate(denominator); `better` says which direction is good.
+#   "NAME:t_x" is the counter t_x (seconds) of benchmark NAME: two totals one
+#   benchmark measured interleaved.
 
 RATIOS = [
     ("knn_k100_vs_nanoflann", "BM_KnnNanoflann/k:100/morton:0", "BM_KnnOurs/k:100/morton:0", "higher", 2.5,
@@ -28,6 +30,9 @@ RATIOS = [
     ("cube_time_over_standard", "BM_Render/scene:0/method:0/threads:2/iterations:1/real_time",
      "BM_Render/scene:0/method:1/threads:2/iterations:1/real_time", "lower", 1.15,
      "cube: time method / standard method, same budget"),
+    ("pathtrace_guided_over_unguided", "BM_GuidedPathTrace/iterations:2400:t_guided",
+     "BM_GuidedPathTrace/iterations:2400:t_unguided", "lower", 1.1,
+     "cube, path tracing CPU per sample: caustic guide (196k photons) / none, interleaved in one run"),
     ("truck_accumulation_over_time", "BM_Render/scene:1/method:2/threads:2/iterations:1/real_time",
      "BM_Render/scene:1/method:0/threads:2/iterations:1/real_time", "higher", 3.0,
      "truck: accumulation / time, same photon budget (error: see bench/reproduce)"),

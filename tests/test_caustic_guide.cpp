@@ -7,6 +7,7 @@
 #include <doctest/doctest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -326,6 +327,7 @@ TEST_CASE("caustic guide: the neighbour cache gives a vertex only photons within
     uint32_t a[CausticGuide::kNeighbours + 1], b[CausticGuide::kNeighbours + 1];
     float da[CausticGuide::kNeighbours + 1], db[CausticGuide::kNeighbours + 1];
     int na = cached.candidates(p, a, da);
+    for (int j = 0; j < na; ++j) a[j] = cached.treeIndexOfRecord(a[j]);
     nonEmpty += na > 0;
     for (int j = 0; j < na; ++j) {
       Vec3f d = positionOf(a[j]) - p;
@@ -352,6 +354,7 @@ TEST_CASE("caustic guide: the neighbour cache gives a vertex only photons within
     int sp, sq;
     if (!subCell(p, rp, sp) || !subCell(q, rq, sq) || rp != rq || sp != sq) continue;
     int nq = cached.candidates(q, b, db);
+    for (int j = 0; j < nq; ++j) b[j] = cached.treeIndexOfRecord(b[j]);
     std::vector<uint32_t> fromP, fromQ;
     for (int j = 0; j < na; ++j)
       if (lengthSquared(positionOf(a[j]) - q) < r2) fromP.push_back(a[j]);
@@ -370,6 +373,47 @@ TEST_CASE("caustic guide: the neighbour cache gives a vertex only photons within
   CHECK(sparseEqual > sparse / 2);
   CHECK(pairs > 5000);
   CHECK(pairsDiffer == 0);
+}
+
+TEST_CASE("caustic guide: the neighbour cache's lists, filled at first use, do not depend on who asks first") {
+  // A sub-cell's list is filled by the first vertex that lands in it, from
+  // the sub-cell's centre: two identical guides asked at the same points in
+  // opposite orders (so different vertices fill each list) give every point
+  // the same candidates, and the cache fills only the sub-cells asked for.
+  auto s = Scene::build(cubeCaustic(40, 30, 1.0f));
+  CausticGuideSettings gs;
+  gs.fraction = 0.5f;
+  gs.photons = 30000;
+  gs.seed = 9;
+  CausticGuide a = CausticGuide::build(*s, gs, Progress{});
+  CausticGuide b = CausticGuide::build(*s, gs, Progress{});
+  REQUIRE(a.enabled());
+  REQUIRE(a.cacheEntries() > 0);
+  CHECK(a.cacheFilled() == 0);
+  Rng rng(21);
+  std::vector<Vec3f> points(20000);
+  for (Vec3f& p : points)
+    p = a.tree().store().position(size_t(rng.uniform() * float(a.photonCount())) % a.photonCount()) +
+        Vec3f{0.2f * (rng.uniform() - 0.5f), 0.02f * rng.uniform(), 0.2f * (rng.uniform() - 0.5f)};
+  constexpr int K = CausticGuide::kNeighbours;
+  std::vector<uint32_t> fromA(points.size() * K, ~0u), fromB(points.size() * K, ~0u);
+  std::vector<int> countA(points.size()), countB(points.size());
+  float d2[K + 1];
+  for (size_t i = 0; i < points.size(); ++i) countA[i] = a.candidates(points[i], &fromA[i * K], d2);
+  for (size_t i = points.size(); i-- > 0;) countB[i] = b.candidates(points[i], &fromB[i * K], d2);
+  int differ = 0, withCandidates = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    withCandidates += countA[i] > 0;
+    differ += countA[i] != countB[i] ||
+              !std::equal(fromA.begin() + long(i * K), fromA.begin() + long(i * K + size_t(countA[i])), fromB.begin() + long(i * K));
+  }
+  MESSAGE("points with candidates " << withCandidates << " of " << points.size() << "; sub-cells filled " << a.cacheFilled()
+                                    << " of " << a.cacheEntries());
+  CHECK(differ == 0);
+  CHECK(withCandidates > 5000);
+  CHECK(a.cacheFilled() == b.cacheFilled());
+  CHECK(a.cacheFilled() > 0);
+  CHECK(a.cacheFilled() <= points.size());
 }
 
 TEST_CASE("caustic guide: guided and unguided path tracing agree in mean, on the image and on the caustic") {

@@ -125,6 +125,10 @@ void printStats(const RenderStats& st) {
   std::fprintf(stderr, "  bytes per photon: %.2f\n", st.bytesPerPhoton);
   std::fprintf(stderr, "  caustic photons: %llu stored, %llu emitted\n", u(st.causticStored), u(st.causticEmitted));
   std::fprintf(stderr, "  global photons: %llu stored, %llu emitted\n", u(st.globalStored), u(st.globalEmitted));
+  if (st.guideStored > 0)
+    std::fprintf(stderr, "  caustic guide: %llu stored, %llu emitted, %s reserved, %.3f s; cache %llu of %llu sub-cells filled\n",
+                 u(st.guideStored), u(st.guideEmitted), formatMiB(st.guideBytes).c_str(), st.guideSeconds,
+                 u(st.guideCellsFilled), u(st.guideCells));
   std::fprintf(stderr, "  photon pass: %.3f s\n", st.photonSeconds);
   std::fprintf(stderr, "  render: %.3f s\n", std::max(0.0, st.seconds - st.photonSeconds));
   std::fprintf(stderr, "  estimates: %llu time-dependent, %llu standard\n", u(st.timeEstimates),

@@ -49,12 +49,28 @@ constexpr int kCacheSubdivision = 2;
 
 const float kMaxOneMinusCos = 2.0f * std::sin(0.5f * kMaxHalfAngle) * std::sin(0.5f * kMaxHalfAngle);
 
-// The upper median of v[0..n) (n <= kNeighbours), by insertion sort.
+// The upper median of v[0..n) (1 <= n <= 8, v has room for 8): v padded
+// with +inf and sorted by the 19-comparator network for 8 (min/max, no
+// data-dependent branch: an insertion sort here mispredicted ~4 branches a
+// call), so v[n/2] is the same value an insertion sort gives.
 float median(float* v, int n) {
-  for (int i = 1; i < n; ++i)
-    for (int j = i; j > 0 && v[j] < v[j - 1]; --j) std::swap(v[j], v[j - 1]);
+  static_assert(CausticGuide::kNeighbours == 8, "the network sorts 8");
+  for (int i = n; i < 8; ++i) v[i] = std::numeric_limits<float>::infinity();
+  auto cx = [v](int a, int b) {
+    float lo = std::min(v[a], v[b]), hi = std::max(v[a], v[b]);
+    v[a] = lo;
+    v[b] = hi;
+  };
+  cx(0, 2), cx(1, 3), cx(4, 6), cx(5, 7);
+  cx(0, 4), cx(1, 5), cx(2, 6), cx(3, 7);
+  cx(0, 1), cx(2, 3), cx(4, 5), cx(6, 7);
+  cx(2, 4), cx(3, 5);
+  cx(1, 4), cx(3, 6);
+  cx(1, 2), cx(3, 4), cx(5, 6);
   return v[n / 2];
 }
+
+int8_t quantizeUnit(float x) { return int8_t(std::lround(std::clamp(x, -1.0f, 1.0f) * 127.0f)); }
 
 bool diffuseLike(const Material& m) {
   return m.type == Material::Type::Diffuse || m.type == Material::Type::Plastic;
@@ -82,6 +98,7 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
   photon::TraceResult traced = photon::tracePhotons(scene, t, progress);
   if (traced.store.size() < size_t(kNeighbours) || traced.exitPoints.size() != traced.store.size()) return g;
 
+  g.emitted_ = traced.emitted;
   g.store_ = std::make_unique<photon::PhotonStore>(std::move(traced.store));
   std::vector<uint32_t> order;
   photon::KdBuildOptions options;
@@ -96,7 +113,11 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
   for (size_t i = 0; i < order.size(); ++i) {
     g.photons_[i].position = g.store_->position(i);
     g.photons_[i].exit = traced.exitPoints[order[i]].point;
-    g.photons_[i].normal = traced.exitPoints[order[i]].normal;
+    Vec3f n = traced.exitPoints[order[i]].normal;
+    g.photons_[i].normal[0] = quantizeUnit(n.x);
+    g.photons_[i].normal[1] = quantizeUnit(n.y);
+    g.photons_[i].normal[2] = quantizeUnit(n.z);
+    g.photons_[i].unused = 0;
   }
 
   // Search radius: the k-NN radius at (up to) 256 photons spread through
@@ -119,15 +140,19 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
   // own nearest other, so the cones join into one cover of the light's
   // image. A vertex takes the median of its photons' half-angles (or the
   // spread of its own photons' directions, if wider). Kept as 1 - cos.
-  photon::KnnQuery nq(kNeighbours);
-  for (size_t i = 0; i < g.photons_.size(); ++i) {
+  // (The compact k-NN: the kd-tree's result, read from one record a node.)
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, g.photons_.size(), 1024), [&](const tbb::blocked_range<size_t>& range) {
+  for (size_t i = range.begin(); i != range.end(); ++i) {
     Vec3f p = g.store_->position(i);
-    int found = g.tree_.knn(p, kNeighbours, g.radius2_, nq);
+    uint32_t nearIndex[kNeighbours + 1];
+    float nearDist2[kNeighbours + 1];
+    int found = g.nearestWithin(p, g.radius2_, nearIndex, nearDist2);
     Vec3f axis[kNeighbours];
     int count = 0;
+    const Vec3f facing = g.photons_[i].facing();
     for (int j = 0; j < found; ++j) {
-      const GuidePhoton& o = g.photons_[nq.index()[j]];
-      if (!(dot(o.normal, g.photons_[i].normal) > kMinNormalCosine)) continue;
+      const GuidePhoton& o = g.photons_[nearIndex[j]];
+      if (!(dot(o.facing(), facing) > kMinNormalCosine)) continue;
       Vec3f d = o.exit - p;
       float len = length(d);
       if (len > 0.0f) axis[count++] = d / len;
@@ -148,65 +173,160 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
     float sh = std::sin(0.5f * half);
     g.photons_[i].oneMinusCos = 2.0f * sh * sh;
   }
+  });
   std::vector<Vec3f> positions(g.store_->size());
   for (size_t i = 0; i < positions.size(); ++i) positions[i] = g.store_->position(i);
   g.occupancy_ = GuideOccupancy::build(positions, radius, kMinFound);
+  g.orderRecords();
   g.fraction_ = s.fraction;
-  g.buildCache(cacheSubdivision);
+  g.allocateCache(cacheSubdivision);
   return g;
 }
 
-void CausticGuide::buildCache(int sub) {
+// Spreads the low 10 bits of v over every third bit.
+static uint32_t spreadBits10(uint32_t v) {
+  v &= 0x3ffu;
+  v = (v | (v << 16)) & 0x030000ffu;
+  v = (v | (v << 8)) & 0x0300f00fu;
+  v = (v | (v << 4)) & 0x030c30c3u;
+  v = (v | (v << 2)) & 0x09249249u;
+  return v;
+}
+
+void CausticGuide::orderRecords() {
+  // Morton order of the positions over their bounds (10 bits an axis),
+  // ties by tree index: a sub-cell's photons are neighbours in space, so
+  // mostly neighbours in memory too.
+  const size_t n = photons_.size();
+  Vec3f lo(std::numeric_limits<float>::infinity()), hi(-std::numeric_limits<float>::infinity());
+  for (const GuidePhoton& r : photons_) {
+    lo = vmin(lo, r.position);
+    hi = vmax(hi, r.position);
+  }
+  std::vector<uint64_t> key(n);
+  for (size_t i = 0; i < n; ++i) {
+    uint32_t q[3];
+    for (int a = 0; a < 3; ++a) {
+      float extent = hi[a] - lo[a];
+      float t = extent > 0.0f ? (photons_[i].position[a] - lo[a]) / extent : 0.0f;
+      q[a] = uint32_t(std::clamp(t, 0.0f, 1.0f) * 1023.0f);
+    }
+    uint64_t morton = spreadBits10(q[0]) | (spreadBits10(q[1]) << 1) | (spreadBits10(q[2]) << 2);
+    key[i] = (morton << 32) | uint64_t(i);
+  }
+  std::sort(key.begin(), key.end());
+  std::vector<GuidePhoton> records(n);
+  treeOfRecord_.resize(n);
+  recordOfTree_.resize(n);
+  for (size_t r = 0; r < n; ++r) {
+    uint32_t t = uint32_t(key[r] & 0xffffffffu);
+    records[r] = photons_[t];
+    treeOfRecord_[r] = t;
+    recordOfTree_[t] = uint32_t(r);
+  }
+  photons_.clear();
+  photons_.shrink_to_fit();
+  photonCount_ = n;
+  recordMemory_ = HugePageBuffer(n * sizeof(GuidePhoton));
+  if (recordMemory_.data()) {
+    GuidePhoton* out = static_cast<GuidePhoton*>(recordMemory_.data());
+    std::copy(records.begin(), records.end(), out);
+    records_ = out;
+  } else {
+    photons_ = std::move(records);  // no mapping: the vector's memory
+    records_ = photons_.data();
+  }
+}
+
+void CausticGuide::allocateCache(int sub) {
   cacheSub_ = 0;
-  cacheIndex_.clear();
+  cacheEntries_ = 0;
+  cache_ = nullptr;
+  cacheMemory_ = HugePageBuffer();
   if (sub < 1 || !occupancy_.built()) return;
-  const std::vector<Vec3f> corners = occupancy_.setCellCorners();
-  const size_t per = size_t(sub) * size_t(sub) * size_t(sub);
-  const size_t entries = corners.size() * per;
-  cacheIndex_.assign(entries * kNeighbours, kNoPhoton);
-  const float step = occupancy_.cellSize() / float(sub);
+  const size_t entries = occupancy_.setCount() * size_t(sub) * size_t(sub) * size_t(sub);
+  if (entries == 0) return;
+  // Zeroed memory from the system (huge pages: core/huge_pages.h).
+  cacheMemory_ = HugePageBuffer(entries * kNeighbours * sizeof(std::atomic<uint32_t>));
+  if (!cacheMemory_.data()) return;  // no cache: a k-NN per vertex, same cones
+  static_assert(sizeof(std::atomic<uint32_t>) == sizeof(uint32_t) && std::atomic<uint32_t>::is_always_lock_free,
+                "slots are plain 32-bit words");
+  cache_ = static_cast<std::atomic<uint32_t>*>(cacheMemory_.data());
+  cacheEntries_ = entries;
   // A photon within the radius of any point of the sub-cell lies within
   // this of its centre (a little more for rounding).
+  const float step = occupancy_.cellSize() / float(sub);
   const float reach = (std::sqrt(radius2_) + 0.5f * std::sqrt(3.0f) * step) * 1.0001f;
-  const float reach2 = reach * reach;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, entries, 256), [&](const tbb::blocked_range<size_t>& range) {
-    uint32_t index[kNeighbours + 1];
-    float d2[kNeighbours + 1];
-    for (size_t e = range.begin(); e != range.end(); ++e) {
-      size_t j = e % per;
-      Vec3f c = corners[e / per];
-      Vec3f centre(c.x + (float(j % size_t(sub)) + 0.5f) * step, c.y + (float((j / size_t(sub)) % size_t(sub)) + 0.5f) * step,
-                   c.z + (float(j / (size_t(sub) * size_t(sub))) + 0.5f) * step);
-      int found = nearestWithin(centre, reach2, index, d2);
-      for (int i = 0; i < found; ++i) cacheIndex_[e * kNeighbours + size_t(i)] = index[i];
-    }
-  });
+  cacheReach2_ = reach * reach;
   cacheSub_ = sub;
+}
+
+size_t CausticGuide::cacheFilled() const {
+  size_t n = 0;
+  for (size_t e = 0; e < cacheEntries_; ++e) n += cache_[e * kNeighbours].load(std::memory_order_relaxed) != 0;
+  return n;
+}
+
+int CausticGuide::cachedList(size_t entry, Vec3f centre, uint32_t* list) const {
+  std::atomic<uint32_t>* slot = &cache_[entry * kNeighbours];
+  uint32_t first = slot[0].load(std::memory_order_acquire);
+  if (first != 0) {
+    if (first == kFilledEmpty) return 0;
+    list[0] = first - 1;
+    int n = 1;
+    for (; n < kNeighbours; ++n) {
+      uint32_t v = slot[n].load(std::memory_order_relaxed);
+      if (v == 0) break;
+      list[n] = v - 1;
+    }
+    return n;
+  }
+  // First visit: the kNeighbours photons nearest the sub-cell's centre
+  // (a function of the sub-cell alone, whoever asks), then published.
+  float d2[kNeighbours + 1];
+  uint32_t found[kNeighbours + 1];
+  int n = nearestWithin(centre, cacheReach2_, found, d2);
+  for (int i = 0; i < n; ++i) found[i] = recordOfTree_[found[i]];
+  for (int i = 1; i < kNeighbours; ++i) slot[i].store(i < n ? found[i] + 1 : 0, std::memory_order_relaxed);
+  slot[0].store(n > 0 ? found[0] + 1 : kFilledEmpty, std::memory_order_release);
+  for (int i = 0; i < n; ++i) list[i] = found[i];
+  return n;
 }
 
 int CausticGuide::candidates(Vec3f p, uint32_t* index, float* dist2) const {
   if (cacheSub_ == 0) {
     if (!occupancy_.mayHaveNear(p)) return 0;  // the k-NN would find < kMinFound
-    return nearest(p, index, dist2);
+    int n = nearest(p, index, dist2);
+    for (int i = 0; i < n; ++i) index[i] = recordOfTree_[index[i]];
+    return n;
   }
   size_t rank;
-  Vec3f local;
-  if (!occupancy_.locate(p, rank, local)) return 0;
+  Vec3f local, corner;
+  if (!occupancy_.locate(p, rank, local, &corner)) return 0;
   const int sub = cacheSub_;
   int jx = std::min(sub - 1, int(local.x * float(sub)));
   int jy = std::min(sub - 1, int(local.y * float(sub)));
   int jz = std::min(sub - 1, int(local.z * float(sub)));
   size_t e = rank * size_t(sub) * size_t(sub) * size_t(sub) + size_t((jz * sub + jy) * sub + jx);
-  const uint32_t* cached = &cacheIndex_[e * kNeighbours];
-  int found = 0;
-  for (int i = 0; i < kNeighbours && cached[i] != kNoPhoton; ++i) {
-    const Vec3f q = photons_[cached[i]].position;
+  const float step = occupancy_.cellSize() / float(sub);
+  Vec3f centre(corner.x + (float(jx) + 0.5f) * step, corner.y + (float(jy) + 0.5f) * step,
+               corner.z + (float(jz) + 0.5f) * step);
+  uint32_t list[kNeighbours];
+  int n = cachedList(e, centre, list);
+  // Keep those within the radius of p itself: distances first (independent
+  // loads), then a branch-free compaction (as one loop, each store's place
+  // waited for the previous photon's load).
+  float d[kNeighbours];
+  for (int i = 0; i < n; ++i) {
+    const Vec3f q = records_[list[i]].position;
     float dx = q.x - p.x, dy = q.y - p.y, dz = q.z - p.z;
-    float d = dx * dx + dy * dy + dz * dz;
-    if (d < radius2_) {
-      index[found] = cached[i];
-      dist2[found++] = d;
-    }
+    d[i] = dx * dx + dy * dy + dz * dz;
+  }
+  int found = 0;
+  for (int i = 0; i < n; ++i) {
+    index[found] = list[i];
+    dist2[found] = d[i];
+    found += d[i] < radius2_;
   }
   return found;
 }
@@ -289,21 +409,29 @@ void CausticGuide::conesAt(const Material& m, Vec3f p, Vec3f n, GuideCones& out)
   float d2[kNeighbours + 1];
   int found = candidates(p, index, d2);
   if (found < kMinFound) return;
+  // Every photon's direction and tests first: no dependence between
+  // photons, so their square roots and divisions overlap. Then the kept
+  // ones are packed without a branch (the outcomes vary vertex to vertex;
+  // as branches they mispredicted, and packing inside the first loop made
+  // each photon wait for the previous one's tests). A zero length gives
+  // NaN, kept by no test.
+  Vec3f dir[kNeighbours];
+  bool keep[kNeighbours];
+  for (int i = 0; i < found; ++i) {
+    const GuidePhoton& o = records_[index[i]];
+    Vec3f d = o.exit - p;
+    d = d * (1.0f / length(d));
+    dir[i] = d;
+    keep[i] = (dot(o.facing(), n) > kMinNormalCosine) & (dot(d, n) > kMinCosine);
+  }
   Vec3f axis[kNeighbours];
   float omc[kNeighbours], dist2[kNeighbours];
   int count = 0;
   for (int i = 0; i < found; ++i) {
-    const GuidePhoton& o = photons_[index[i]];
-    if (!(dot(o.normal, n) > kMinNormalCosine)) continue;
-    Vec3f d = o.exit - p;
-    float len = length(d);
-    if (!(len > 0.0f)) continue;
-    d = d / len;
-    if (dot(d, n) > kMinCosine) {
-      omc[count] = o.oneMinusCos;
-      dist2[count] = d2[i];
-      axis[count++] = d;
-    }
+    omc[count] = records_[index[i]].oneMinusCos;
+    dist2[count] = d2[i];
+    axis[count] = dir[i];
+    count += keep[i];
   }
   if (count < kMinFound) return;
   float fraction = fraction_;

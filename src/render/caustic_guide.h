@@ -26,16 +26,20 @@
 // share of the mixture falls. An occupancy grid (render/guide_occupancy.h)
 // answers for the many vertices with no photon near; elsewhere a vertex's
 // photons come from its grid sub-cell's list of 8, cached before the first
-// pixel (a k-NN per vertex cost 0.14-0.24x of an unguided path's instructions;
-// the cones still aim from the vertex itself, docs/sampling.md). The
-// guide is a fixed function of the scene and the seed,
-// built before any pixel by every process alike, so images stay identical
-// across threads and MPI ranks.
+// a sub-cell's list of 8, filled the first time a vertex lands in it (a
+// k-NN per vertex cost 0.14-0.24x of an unguided path's instructions; the
+// cones still aim from the vertex itself, docs/sampling.md). The guide, and
+// each list, is a fixed function of the scene and the seed (a list holds
+// the photons nearest its sub-cell's centre, whichever vertex asks first),
+// so images stay identical across threads and MPI ranks.
 #pragma once
+#include <atomic>
 #include <cstdint>
+#include <cstdlib>
 #include <memory>
 #include <vector>
 
+#include "core/huge_pages.h"
 #include "core/progress.h"
 #include "photon/kdtree.h"
 #include "photon/store.h"
@@ -63,7 +67,8 @@ class CausticGuide {
   static CausticGuide build(const Scene& scene, const CausticGuideSettings& settings, const Progress& progress);
 
   bool enabled() const { return fraction_ > 0.0f; }
-  size_t photonCount() const { return photons_.size(); }
+  size_t photonCount() const { return photonCount_; }
+  uint64_t photonsEmitted() const { return emitted_; }  // paths traced for the guide
   float radius() const { return std::sqrt(radius2_); }
   const GuideOccupancy& occupancy() const { return occupancy_; }
   // Cones for a vertex at p on material m with shading normal n (on the
@@ -85,19 +90,31 @@ class CausticGuide {
   // cacheSubdivision()^3 sub-cells; conesAt takes a vertex's photons from
   // its sub-cell's list (the kNeighbours nearest to the sub-cell's centre
   // within radius() + the sub-cell's half diagonal, filtered by distance
-  // from the vertex) instead of a k-NN of its own.
+  // from the vertex) instead of a k-NN of its own. A list is filled the
+  // first time a vertex lands in its sub-cell (most sub-cells lie off every
+  // surface and are never asked for), into zeroed memory from the system.
   int cacheSubdivision() const { return cacheSub_; }
-  size_t cacheEntries() const { return cacheIndex_.size() / kNeighbours; }
-  size_t cacheBytes() const { return cacheIndex_.size() * sizeof(uint32_t) + occupancy_.cellCount() / 16; }
-  // The photons (tree indices) a vertex at p takes its cones from: the
-  // cache's list, or its own k-NN without a cache. Returns count.
+  size_t cacheEntries() const { return cacheEntries_; }
+  // Bytes reserved (address space; resident only where filled).
+  size_t cacheBytes() const { return cacheEntries_ * kNeighbours * sizeof(uint32_t) + occupancy_.bytes(); }
+  size_t cacheFilled() const;  // sub-cells whose list has been filled (a scan: for stats and tests)
+  // Bytes of the photon records and tree nodes kept for rendering.
+  size_t photonBytes() const {
+    return photonCount_ * (sizeof(GuidePhoton) + 2 * sizeof(uint32_t)) + nodes_.size() * sizeof(Node) +
+           (store_ ? store_->bytesAllocated() : 0);
+  }
+  // The photons a vertex at p takes its cones from, as record indices
+  // (treeIndexOfRecord maps them to tree()'s): the cache's list, or its own
+  // k-NN without a cache. Returns count.
   int candidates(Vec3f p, uint32_t* index, float* dist2) const;
+  uint32_t treeIndexOfRecord(uint32_t record) const { return treeOfRecord_[record]; }
   // Sub-cells per occupancy cell and axis for the cache; 0: no cache.
   static CausticGuide build(const Scene& scene, const CausticGuideSettings& settings, const Progress& progress,
                             int cacheSubdivision);
 
  private:
   float fraction_ = 0.0f;
+  uint64_t emitted_ = 0;
   float radius2_ = 0.0f;
   float trust2_ = 0.0f;  // (median k-NN radius)^2: beyond it c falls
   std::unique_ptr<photon::PhotonStore> store_;  // positions, in the tree's order
@@ -107,22 +124,45 @@ class CausticGuide {
     uint32_t axis;
   };
   std::vector<Node> nodes_;
-  // What a vertex reads of each of its photons, in one record (one cache
-  // line fetch per photon), in the tree's order.
-  struct GuidePhoton {
+  // What a vertex reads of each of its photons, in one 32-byte record
+  // aligned to 32 (never split over two cache lines).
+  struct alignas(32) GuidePhoton {
     Vec3f position;     // where it was stored (the cache's distance test)
     Vec3f exit;         // last specular vertex
-    Vec3f normal;       // of the surface it was stored on, facing its arrival
     float oneMinusCos;  // 1 - cos of its cone's half-angle
+    // Normal of the surface it was stored on, facing its arrival, x127
+    // rounded: only tested against 60 degrees (kMinNormalCosine), where
+    // the rounding moves the test by < 1 degree.
+    int8_t normal[3];
+    uint8_t unused;
+    Vec3f facing() const { return Vec3f(float(normal[0]), float(normal[1]), float(normal[2])) * (1.0f / 127.0f); }
   };
+  static_assert(sizeof(GuidePhoton) == 32, "one guide photon record is 32 bytes");
+  // In Morton order of position (orderRecords), not the tree's.
+  // photons_ while building; then records_, on huge pages (core/huge_pages.h).
   std::vector<GuidePhoton> photons_;
+  HugePageBuffer recordMemory_;
+  const GuidePhoton* records_ = nullptr;
+  size_t photonCount_ = 0;
+  std::vector<uint32_t> treeOfRecord_, recordOfTree_;
+  void orderRecords();
   int nearestWithin(Vec3f p, float r2, uint32_t* index, float* dist2) const;
-  void buildCache(int subdivision);
+  void allocateCache(int subdivision);
+  // The sub-cell's list (record indices, in the k-NN's heap order), filled now
+  // if no vertex has asked for it yet. Returns its length.
+  int cachedList(size_t entry, Vec3f centre, uint32_t* list) const;
   int cacheSub_ = 0;
-  // kNeighbours per sub-cell (one 32-byte record), by occupancy rank then
-  // sub-cell; kNoPhoton after the last.
-  static constexpr uint32_t kNoPhoton = 0xffffffffu;
-  std::vector<uint32_t> cacheIndex_;
+  float cacheReach2_ = 0.0f;  // (radius + half a sub-cell's diagonal)^2, a little more
+  // kNeighbours slots per sub-cell (one 32-byte record), by occupancy rank
+  // then sub-cell. A slot holds a record index + 1, 0 after the list's last;
+  // slot 0 is 0 while the list is unfilled and kFilledEmpty for a filled
+  // empty list. Slot 0 is written last (release) and read first (acquire),
+  // so a reader sees a whole list or none; two threads filling one list
+  // write the same values.
+  static constexpr uint32_t kFilledEmpty = 0xffffffffu;
+  HugePageBuffer cacheMemory_;
+  std::atomic<uint32_t>* cache_ = nullptr;
+  size_t cacheEntries_ = 0;
   // Where a vertex cannot find kMinFound photons within the radius: there
   // conesAt skips the k-NN (same result, most vertices are such).
   GuideOccupancy occupancy_;

@@ -81,14 +81,18 @@ GuideOccupancy GuideOccupancy::build(const std::vector<Vec3f>& points, float rad
         }
       }
   }
-  g.bits_.assign((count.size() + 63) / 64, 0);
-  for (size_t i = 0; i < count.size(); ++i)
-    if (count[i] >= minCount) g.bits_[i >> 6] |= uint64_t(1) << (i & 63);
-  g.rank_.resize(g.bits_.size());
+  g.bx_ = (g.nx_ + 3) / 4;
+  g.by_ = (g.ny_ + 3) / 4;
+  g.bz_ = (g.nz_ + 3) / 4;
+  g.words_.assign(size_t(g.bx_) * size_t(g.by_) * size_t(g.bz_), Word{0, 0, 0});
+  for (int z = 0; z < g.nz_; ++z)
+    for (int y = 0; y < g.ny_; ++y)
+      for (int x = 0; x < g.nx_; ++x)
+        if (count[g.cellIndex(x, y, z)] >= minCount) g.words_[g.wordIndex(x, y, z)].bits |= uint64_t(1) << bitIndex(x, y, z);
   uint32_t before = 0;
-  for (size_t w = 0; w < g.bits_.size(); ++w) {
-    g.rank_[w] = before;
-    before += uint32_t(__builtin_popcountll(g.bits_[w]));
+  for (Word& w : g.words_) {
+    w.rank = before;
+    before += uint32_t(__builtin_popcountll(w.bits));
   }
   g.built_ = true;
   return g;
@@ -96,7 +100,7 @@ GuideOccupancy GuideOccupancy::build(const std::vector<Vec3f>& points, float rad
 
 size_t GuideOccupancy::setCount() const {
   size_t s = 0;
-  for (uint64_t w : bits_) s += size_t(__builtin_popcountll(w));
+  for (const Word& w : words_) s += size_t(__builtin_popcountll(w.bits));
   return s;
 }
 
@@ -104,12 +108,15 @@ std::vector<Vec3f> GuideOccupancy::setCellCorners() const {
   std::vector<Vec3f> corners;
   if (!built_) return corners;
   corners.reserve(setCount());
-  for (int z = 0; z < nz_; ++z)
-    for (int y = 0; y < ny_; ++y)
-      for (int x = 0; x < nx_; ++x) {
-        size_t c = cellIndex(x, y, z);
-        if ((bits_[c >> 6] >> (c & 63)) & 1u)
-          corners.push_back(Vec3f(lo_.x + float(x) * cell_, lo_.y + float(y) * cell_, lo_.z + float(z) * cell_));
+  // Rank order: word by word, bit by bit.
+  for (int bz = 0; bz < bz_; ++bz)
+    for (int by = 0; by < by_; ++by)
+      for (int bx = 0; bx < bx_; ++bx) {
+        uint64_t bits = words_[(size_t(bz) * size_t(by_) + size_t(by)) * size_t(bx_) + size_t(bx)].bits;
+        for (; bits; bits &= bits - 1) {
+          unsigned b = unsigned(__builtin_ctzll(bits));
+          corners.push_back(cellCorner(4 * bx + int(b & 3), 4 * by + int((b >> 2) & 3), 4 * bz + int(b >> 4)));
+        }
       }
   return corners;
 }

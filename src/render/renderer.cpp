@@ -289,7 +289,9 @@ constexpr size_t kMinGuidePhotons = 20000, kMaxGuidePhotons = 200000;
 
 // The path tracer's caustic guide (render/caustic_guide.h): traced with the
 // render's seed and sampler, so an image depends on nothing else.
-CausticGuide buildCausticGuide(const Scene& scene, const RenderOptions& opt, const Progress& progress) {
+CausticGuide buildCausticGuide(const Scene& scene, const RenderOptions& opt, const Progress& progress,
+                               RenderStats& st) {
+  Timer timer;
   CausticGuideSettings s;
   s.fraction = opt.causticGuiding;
   // Automatic: one guide photon per 100 camera samples, within [20k, 200k]
@@ -299,7 +301,13 @@ CausticGuide buildCausticGuide(const Scene& scene, const RenderOptions& opt, con
                                    : size_t(std::clamp(samples / 100.0, double(kMinGuidePhotons), double(kMaxGuidePhotons)));
   s.seed = opt.seed;
   s.sampler = opt.sampler;
-  return CausticGuide::build(scene, s, progress);
+  CausticGuide guide = CausticGuide::build(scene, s, progress);
+  st.guideStored = guide.photonCount();
+  st.guideEmitted = guide.photonsEmitted();
+  st.guideBytes = guide.enabled() ? guide.cacheBytes() + guide.photonBytes() : 0;
+  st.guideCells = guide.cacheEntries();
+  st.guideSeconds = timer.seconds();
+  return guide;
 }
 
 PhotonIntegratorSettings integratorSettings(const Scene& scene, const RenderOptions& opt, bool timeDependent) {
@@ -454,9 +462,10 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
   plan.owners = &owners;
 
   if (opt.method == "pathtrace") {
-    CausticGuide guide = buildCausticGuide(scene, opt, progress);
+    CausticGuide guide = buildCausticGuide(scene, opt, progress, st);
     PathTracer pt(scene, opt.maxDepth, &guide);
     renderPixels(scene, pt, plan, "render", progress, film);
+    st.guideCellsFilled = guide.cacheFilled();
   } else if (opt.method == "accumulation") {
     // N in-between frames at equally spaced times, each with its own maps
     // holding 1/N of the budget, rendered at its own time and averaged.
@@ -530,9 +539,10 @@ Film renderFrame(const Scene& scene, const RenderOptions& opt, const FrameInput&
   plan.time01Lo = scene.shutter.normalized(frame.shutter.open);
   plan.time01Hi = scene.shutter.normalized(frame.shutter.close);
   if (opt.method == "pathtrace") {
-    CausticGuide guide = buildCausticGuide(scene, opt, progress);
+    CausticGuide guide = buildCausticGuide(scene, opt, progress, st);
     PathTracer pt(scene, opt.maxDepth, &guide);
     renderPixels(scene, pt, plan, "render", progress, film);
+    st.guideCellsFilled = guide.cacheFilled();
   } else {
     PhotonIntegratorSettings s = integratorSettings(scene, opt, opt.method == "time" && scene.hasMotion);
     if (!std::isfinite(opt.estimate.maxTimeDistance))

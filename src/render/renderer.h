@@ -107,6 +107,12 @@ struct RenderStats {
   size_t causticStored = 0, globalStored = 0;
   uint64_t causticEmitted = 0, globalEmitted = 0;
   double bytesPerPhoton = 0;
+  // The path tracer's caustic guide (render/caustic_guide.h): photons
+  // stored and emitted, its neighbour cache's bytes, seconds to build it all.
+  size_t guideStored = 0;
+  uint64_t guideEmitted = 0, guideBytes = 0;
+  size_t guideCells = 0, guideCellsFilled = 0;  // its neighbour cache's sub-cells: all, and filled by the render
+  double guideSeconds = 0;
   uint64_t standardEstimates = 0, timeEstimates = 0;
   int minSpp = 0, maxSpp = 0;  // over pixels
   uint64_t peakResidentBytes = 0;  // of the whole process, at the end of render() (core/memory.h)
