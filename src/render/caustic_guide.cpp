@@ -141,38 +141,39 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
   // image. A vertex takes the median of its photons' half-angles (or the
   // spread of its own photons' directions, if wider). Kept as 1 - cos.
   // (The compact k-NN: the kd-tree's result, read from one record a node.)
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, g.photons_.size(), 1024), [&](const tbb::blocked_range<size_t>& range) {
-  for (size_t i = range.begin(); i != range.end(); ++i) {
-    Vec3f p = g.store_->position(i);
-    uint32_t nearIndex[kNeighbours + 1];
-    float nearDist2[kNeighbours + 1];
-    int found = g.nearestWithin(p, g.radius2_, nearIndex, nearDist2);
-    Vec3f axis[kNeighbours];
-    int count = 0;
-    const Vec3f facing = g.photons_[i].facing();
-    for (int j = 0; j < found; ++j) {
-      const GuidePhoton& o = g.photons_[nearIndex[j]];
-      if (!(dot(o.facing(), facing) > kMinNormalCosine)) continue;
-      Vec3f d = o.exit - p;
-      float len = length(d);
-      if (len > 0.0f) axis[count++] = d / len;
-    }
-    float half = kMaxHalfAngle;
-    if (count >= 2) {
-      float nearest[kNeighbours];
-      for (int a = 0; a < count; ++a) {
-        float best = 4.0f;
-        for (int b = 0; b < count; ++b)
-          if (a != b) best = std::min(best, lengthSquared(axis[a] - axis[b]));
-        nearest[a] = best;  // squared chord to the nearest other axis
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, g.photons_.size(), 1024),
+                    [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      Vec3f p = g.store_->position(i);
+      uint32_t nearIndex[kNeighbours + 1];
+      float nearDist2[kNeighbours + 1];
+      int found = g.nearestWithin(p, g.radius2_, nearIndex, nearDist2);
+      Vec3f axis[kNeighbours];
+      int count = 0;
+      const Vec3f facing = g.photons_[i].facing();
+      for (int j = 0; j < found; ++j) {
+        const GuidePhoton& o = g.photons_[nearIndex[j]];
+        if (!(dot(o.facing(), facing) > kMinNormalCosine)) continue;
+        Vec3f d = o.exit - p;
+        float len = length(d);
+        if (len > 0.0f) axis[count++] = d / len;
       }
-      std::nth_element(nearest, nearest + count / 2, nearest + count);
-      float angle = 2.0f * std::asin(std::min(1.0f, 0.5f * std::sqrt(nearest[count / 2])));
-      half = std::clamp(1.5f * angle, kMinHalfAngle, kMaxHalfAngle);
+      float half = kMaxHalfAngle;
+      if (count >= 2) {
+        float nearest[kNeighbours];
+        for (int a = 0; a < count; ++a) {
+          float best = 4.0f;
+          for (int b = 0; b < count; ++b)
+            if (a != b) best = std::min(best, lengthSquared(axis[a] - axis[b]));
+          nearest[a] = best;  // squared chord to the nearest other axis
+        }
+        std::nth_element(nearest, nearest + count / 2, nearest + count);
+        float angle = 2.0f * std::asin(std::min(1.0f, 0.5f * std::sqrt(nearest[count / 2])));
+        half = std::clamp(1.5f * angle, kMinHalfAngle, kMaxHalfAngle);
+      }
+      float sh = std::sin(0.5f * half);
+      g.photons_[i].oneMinusCos = 2.0f * sh * sh;
     }
-    float sh = std::sin(0.5f * half);
-    g.photons_[i].oneMinusCos = 2.0f * sh * sh;
-  }
   });
   std::vector<Vec3f> positions(g.store_->size());
   for (size_t i = 0; i < positions.size(); ++i) positions[i] = g.store_->position(i);

@@ -25,17 +25,16 @@
 // unbiased whatever the guide holds. Where the photons are far, the guide's
 // share of the mixture falls. An occupancy grid (render/guide_occupancy.h)
 // answers for the many vertices with no photon near; elsewhere a vertex's
-// photons come from its grid sub-cell's list of 8, cached before the first
-// a sub-cell's list of 8, filled the first time a vertex lands in it (a
-// k-NN per vertex cost 0.14-0.24x of an unguided path's instructions; the
-// cones still aim from the vertex itself, docs/sampling.md). The guide, and
+// photons come from its grid sub-cell's list of 8, filled the first time a
+// vertex lands in the sub-cell (a k-NN per vertex cost 0.14-0.24x of an
+// unguided path's instructions; the cones still aim from the vertex
+// itself, docs/sampling.md). The guide, and
 // each list, is a fixed function of the scene and the seed (a list holds
 // the photons nearest its sub-cell's centre, whichever vertex asks first),
 // so images stay identical across threads and MPI ranks.
 #pragma once
 #include <atomic>
 #include <cstdint>
-#include <cstdlib>
 #include <memory>
 #include <vector>
 
@@ -138,8 +137,9 @@ class CausticGuide {
     Vec3f facing() const { return Vec3f(float(normal[0]), float(normal[1]), float(normal[2])) * (1.0f / 127.0f); }
   };
   static_assert(sizeof(GuidePhoton) == 32, "one guide photon record is 32 bytes");
-  // In Morton order of position (orderRecords), not the tree's.
-  // photons_ while building; then records_, on huge pages (core/huge_pages.h).
+  // The records: photons_ in the tree's order while building; then
+  // records_, in Morton order of position (orderRecords; treeOfRecord_ and
+  // recordOfTree_ map between the two), on 2 MB pages (core/huge_pages.h).
   std::vector<GuidePhoton> photons_;
   HugePageBuffer recordMemory_;
   const GuidePhoton* records_ = nullptr;
