@@ -84,14 +84,6 @@ scene::SceneDescription roundTrip(const scene::SceneDescription& d, const std::s
   return back;
 }
 
-const char* kHeader = R"(
-LookAt 0 1 6  0 0.5 0  0 1 0
-Camera "perspective" "float fov" 40
-Film "image" "integer xresolution" 24 "integer yresolution" 16
-Sampler "halton" "integer pixelsamples" 4
-Integrator "path" "integer maxdepth" 4
-)";
-
 }  // namespace
 
 TEST_CASE("pbrt tokenizer: strings, numbers, comments and brackets carry their line") {
