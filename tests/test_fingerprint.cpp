@@ -139,6 +139,19 @@ TEST_CASE("fingerprint: every image-changing option changes it, and is named") {
   CHECK(settingDifferences(withAlpha, f0.settings, "old.exr") ==
         std::vector<std::string>{"future_option: 0.7 in old.exr, not set now"});
   CHECK(fingerprintOfSettings(withAlpha) != f0.value);
+  // A state written before the estimator had a version (an older tdpm), or
+  // with another version: named as such, and a different fingerprint.
+  CHECK(f0.settings.at(kEstimatorSettingKey) == kEstimatorVersion);
+  std::map<std::string, std::string> older = f0.settings;
+  older.erase(kEstimatorSettingKey);
+  CHECK(settingDifferences(older, f0.settings, "old.exr") ==
+        std::vector<std::string>{"the estimator differs (an older version in old.exr, version " +
+                                 std::string(kEstimatorVersion) + " now): it was written by another tdpm"});
+  CHECK(fingerprintOfSettings(older) != f0.value);
+  std::map<std::string, std::string> other = f0.settings;
+  other[kEstimatorSettingKey] = "1";
+  CHECK(settingDifferences(other, f0.settings, "old.exr").size() == 1);
+  CHECK(settingDifferences(other, f0.settings, "old.exr")[0].find("version 1 in old.exr") != std::string::npos);
 }
 
 TEST_CASE("fingerprint: any change to the scene is 'the scene differs'") {

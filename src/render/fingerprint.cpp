@@ -145,6 +145,7 @@ RenderFingerprint fingerprintOf(const scene::SceneDescription& scene, const Rend
   RenderFingerprint f;
   f.settings = renderSettings(options, scene.camera.width, scene.camera.height);
   f.settings[kSceneSettingKey] = sceneDigest(scene);
+  f.settings[kEstimatorSettingKey] = kEstimatorVersion;
   f.value = fingerprintOfSettings(f.settings);
   return f;
 }
@@ -163,9 +164,14 @@ std::vector<std::string> settingDifferences(const std::map<std::string, std::str
   const std::string* sb = valueIn(before, kSceneSettingKey);
   const std::string* sn = valueIn(now, kSceneSettingKey);
   if (!sb || !sn || *sb != *sn) out.push_back("the scene differs");
+  const std::string* eb = valueIn(before, kEstimatorSettingKey);
+  const std::string* en = valueIn(now, kEstimatorSettingKey);
+  if (!eb || !en || *eb != *en)
+    out.push_back(std::string("the estimator differs (") + (eb ? "version " + *eb : "an older version") + " in " + file +
+                  ", " + (en ? "version " + *en : "an older version") + " now): it was written by another tdpm");
   for (const auto& kv : keys) {
     const std::string& key = kv.first;
-    if (key == kSceneSettingKey) continue;
+    if (key == kSceneSettingKey || key == kEstimatorSettingKey) continue;
     const std::string* b = valueIn(before, key);
     const std::string* n = valueIn(now, key);
     if (b && n && *b == *n) continue;

@@ -27,6 +27,14 @@ namespace tdpm {
 
 // The key of the scene's digest in the settings map.
 inline constexpr const char* kSceneSettingKey = "scene";
+// The key of the estimator's version in the settings map, and this build's
+// version: bumped whenever what a method adds for a sample changes with the
+// same scene and options, so that --resume refuses a state whose samples
+// estimate differently from this run's. 2: the photon methods' eye path
+// splits its first two glass vertices and passes through sharp metals
+// (stop 18); states written before it carry no version.
+inline constexpr const char* kEstimatorSettingKey = "estimator";
+inline constexpr const char* kEstimatorVersion = "2";
 
 // The image-changing options as text (floats "%.9g", exact): method, seed,
 // sampler, spp (per pass in a progressive render), max_spp, contrast,
@@ -55,7 +63,7 @@ std::string fingerprintOfSettings(const std::map<std::string, std::string>& sett
 
 // What differs between the settings stored in a file (`before`, from
 // `file`) and those of this run (`now`), one phrase each, in name order:
-// "the scene differs", "photons: 200000 in old.exr, 100000 now",
+// "the scene differs", "the estimator differs (...)", "photons: 200000 in old.exr, 100000 now",
 // "alpha: 0.7 in old.exr, not set now", "gather: not set in old.exr, 1 now".
 std::vector<std::string> settingDifferences(const std::map<std::string, std::string>& before,
                                             const std::map<std::string, std::string>& now, const std::string& file);
