@@ -54,6 +54,16 @@ void regionMean(const Film& f, Region r, double& mean, double& error) {
   error = std::sqrt(v) / n;
 }
 
+// A guide over scene s with the default mixture weight; subdivision < 0:
+// the build's own neighbour-cache subdivision.
+CausticGuide guideFor(const Scene& s, size_t photons, uint64_t seed, int subdivision = -1) {
+  CausticGuideSettings gs;
+  gs.fraction = 0.5f;
+  gs.photons = photons;
+  gs.seed = seed;
+  return subdivision < 0 ? CausticGuide::build(s, gs, Progress{}) : CausticGuide::build(s, gs, Progress{}, subdivision);
+}
+
 Film renderCube(const Scene& s, float guiding, int spp, uint64_t seed, int threads = 0) {
   RenderOptions o;
   o.method = "pathtrace";
@@ -205,11 +215,7 @@ TEST_CASE("caustic guide: in the ball's faint halo on the floor, the cones hold 
   // cover it (97-99.5%). Counted over directions near the cones, from
   // floor points around the box, each followed through the glass.
   auto s = Scene::build(cubeCaustic(40, 30, 1.0f));
-  CausticGuideSettings gs;
-  gs.fraction = 0.5f;
-  gs.photons = 50000;
-  gs.seed = 3;
-  CausticGuide guide = CausticGuide::build(*s, gs, Progress{});
+  CausticGuide guide = guideFor(*s, 50000, 3);
   REQUIRE(guide.enabled());
   Material diffuse;
   diffuse.type = Material::Type::Diffuse;
@@ -254,11 +260,7 @@ TEST_CASE("caustic guide: its compact k-NN returns what the kd-tree's k-NN retur
   // CausticGuide::nearest repeats KdTree::knn's traversal over 16-byte
   // nodes; the cones (and images) depend on the order of the result too.
   auto s = Scene::build(cubeCaustic(40, 30, 1.0f));
-  CausticGuideSettings gs;
-  gs.fraction = 0.5f;
-  gs.photons = 30000;
-  gs.seed = 5;
-  CausticGuide guide = CausticGuide::build(*s, gs, Progress{});
+  CausticGuide guide = guideFor(*s, 30000, 5);
   REQUIRE(guide.enabled());
   photon::KnnQuery q(CausticGuide::kNeighbours);
   Rng rng(11);
@@ -297,12 +299,8 @@ TEST_CASE("caustic guide: the neighbour cache gives a vertex only photons within
   // list: each one's candidates within the other's radius are the same, in
   // the same order (a cache filled by whichever vertex came first fails it).
   auto s = Scene::build(cubeCaustic(40, 30, 1.0f));
-  CausticGuideSettings gs;
-  gs.fraction = 0.5f;
-  gs.photons = 30000;
-  gs.seed = 5;
-  CausticGuide cached = CausticGuide::build(*s, gs, Progress{});
-  CausticGuide plain = CausticGuide::build(*s, gs, Progress{}, 0);
+  CausticGuide cached = guideFor(*s, 30000, 5);
+  CausticGuide plain = guideFor(*s, 30000, 5, 0);
   REQUIRE(cached.enabled());
   REQUIRE(cached.cacheSubdivision() >= 1);
   REQUIRE(plain.cacheSubdivision() == 0);
@@ -381,12 +379,8 @@ TEST_CASE("caustic guide: the neighbour cache's lists, filled at first use, do n
   // opposite orders (so different vertices fill each list) give every point
   // the same candidates, and the cache fills only the sub-cells asked for.
   auto s = Scene::build(cubeCaustic(40, 30, 1.0f));
-  CausticGuideSettings gs;
-  gs.fraction = 0.5f;
-  gs.photons = 30000;
-  gs.seed = 9;
-  CausticGuide a = CausticGuide::build(*s, gs, Progress{});
-  CausticGuide b = CausticGuide::build(*s, gs, Progress{});
+  CausticGuide a = guideFor(*s, 30000, 9);
+  CausticGuide b = guideFor(*s, 30000, 9);
   REQUIRE(a.enabled());
   REQUIRE(a.cacheEntries() > 0);
   CHECK(a.cacheFilled() == 0);
