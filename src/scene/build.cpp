@@ -48,13 +48,18 @@ Motion makeMotion(const scene::TransformDesc& placement, const scene::MotionDesc
   return Motion::keyframed(p, toKeys(motion), shutter);
 }
 
-std::vector<std::vector<Vec3f>> stepVertices(const Motion& m, const std::vector<Vec3f>& local) {
-  std::vector<std::vector<Vec3f>> steps(size_t(m.stepCount()));
-  for (int s = 0; s < m.stepCount(); ++s) {
-    steps[size_t(s)].reserve(local.size());
-    for (Vec3f v : local) steps[size_t(s)].push_back(m.step(s).point(v));
+// A mesh into Embree: world-space vertices when it stands still, else its
+// object-space vertices under the motion's step transforms (an instance).
+uint32_t addMesh(EmbreeScene& embree, const Motion& m, const TriangleMesh& mesh) {
+  if (!m.moving()) {
+    std::vector<Vec3f> world;
+    world.reserve(mesh.vertices.size());
+    for (Vec3f v : mesh.vertices) world.push_back(m.step(0).point(v));
+    return embree.addTriangles(world, mesh.indices);
   }
-  return steps;
+  std::vector<Affine3f> steps;
+  for (int s = 0; s < m.stepCount(); ++s) steps.push_back(m.step(s));
+  return embree.addMovingTriangles(mesh.vertices, mesh.indices, steps);
 }
 
 // Uniform scale factor of a step matrix (spheres require uniform scale).
@@ -145,7 +150,7 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
         o.faceNormals.push_back(len > 0 ? n / len : Vec3f(0, 1, 0));
       }
       s.geometryOwner_.push_back(int32_t(s.objects.size()));
-      uint32_t id = s.embree_.addTriangles(stepVertices(o.motion, mesh.vertices), mesh.indices);
+      uint32_t id = addMesh(s.embree_, o.motion, mesh);
       TDPM_ASSERT(id + 1 == s.geometryOwner_.size(), "geometry ids out of order");
     }
     if (!o.motion.moving()) {
@@ -171,7 +176,7 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
       // The emitter is geometry too: camera and BSDF rays can hit it.
       TriangleMesh quad = makeQuad(l.size.x, l.size.y);
       s.geometryOwner_.push_back(-int32_t(s.lights.size()) - 1);
-      l.geometryId = s.embree_.addTriangles(stepVertices(l.motion, quad.vertices), quad.indices);
+      l.geometryId = addMesh(s.embree_, l.motion, quad);
       Bounds3f local;
       for (Vec3f v : quad.vertices) local.extend(v);
       Bounds3f swept = l.motion.sweptBounds(local);
