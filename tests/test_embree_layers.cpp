@@ -1,5 +1,5 @@
 // tests/test_embree_layers.cpp — scene/embree_scene's layers (still meshes,
-// spheres, moving meshes as instances, the bounds gates in front of the
+// spheres, moving meshes, the bounds gates in front of the
 // last two) give the closest hit a brute-force search over every primitive
 // gives, with the id the add* call returned, at any ray time; and occlusion
 // agrees with it.

@@ -49,7 +49,7 @@ Motion makeMotion(const scene::TransformDesc& placement, const scene::MotionDesc
 }
 
 // A mesh into Embree: world-space vertices when it stands still, else its
-// object-space vertices under the motion's step transforms (an instance).
+// object-space vertices under the motion's step transforms.
 uint32_t addMesh(EmbreeScene& embree, const Motion& m, const TriangleMesh& mesh) {
   if (!m.moving()) {
     std::vector<Vec3f> world;

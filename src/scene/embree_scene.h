@@ -1,13 +1,11 @@
 // scene/embree_scene.h — the only place that talks to Embree 3.
 // Still geometry goes in as world-space vertices; a rigidly moving mesh as
-// its object-space vertices and one 3x4 transform per time step, which
-// Embree instances and blends linearly in ray time (the blend
-// motion/Motion::atNormalized defines; the same points as blending the
-// transformed vertices). Why instances: Embree's motion-blur triangle BVH
-// cost ~1,030 instructions a ray on scenes/cube-caustic.json for a 12-
-// triangle moving box, more than the rest of the scene together, and the
-// render 1.75x the time of the same scene with the box still; an instance
-// transforms the ray once and intersects a still BVH. Rays come back as
+// its object-space vertices and its object-to-world transform at each of N
+// equally spaced time steps, from which the vertices of every step are
+// made (Embree blends them linearly in ray time, the blend
+// motion/Motion::atNormalized defines). Geometry is kept in layers, each
+// its own Embree scene, and a ray visits the sphere and moving layers only
+// where their bounds are (embree_scene.cpp says why). Rays come back as
 // raw hits. Device and scene handles are owned here.
 #pragma once
 #include <cstdint>
@@ -42,8 +40,8 @@ class EmbreeScene {
   void commit();
 
   // time01: normalised shutter time in [0,1].
-  // hit.geometryId is the id the add* call returned (for a moving mesh,
-  // its instance's), hit.primitiveId the triangle's index in its mesh.
+  // hit.geometryId is the id the add* call returned (0, 1, 2, ... in call
+  // order, whatever the layer), hit.primitiveId the triangle's index in its mesh.
   bool intersect(Vec3f origin, Vec3f direction, float tFar, float time01, RawHit& hit) const;
   bool occluded(Vec3f origin, Vec3f direction, float tFar, float time01) const;
 
