@@ -31,8 +31,9 @@ RATIOS = [
      "BM_Render/scene:0/method:1/threads:2/iterations:1/real_time", "lower", 1.15,
      "cube: time method / standard method, same budget"),
     ("pathtrace_guided_over_unguided", "BM_GuidedPathTrace/iterations:2400:t_guided",
-     "BM_GuidedPathTrace/iterations:2400:t_unguided", "lower", 1.1,
-     "cube, path tracing CPU per sample: caustic guide (196k photons) / none, interleaved in one run"),
+     "BM_GuidedPathTrace/iterations:2400:t_unguided", "lower", None,
+     "cube, path tracing CPU per sample: caustic guide (196k photons) / none, interleaved in one run "
+     "(issue 9's <= 1.1x is against the issue's start, two builds: bench/pathtrace-before-after)"),
     ("truck_accumulation_over_time", "BM_Render/scene:1/method:2/threads:2/iterations:1/real_time",
      "BM_Render/scene:1/method:0/threads:2/iterations:1/real_time", "higher", 3.0,
      "truck: accumulation / time, same photon budget (error: see bench/reproduce)"),
