@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 
 #include <unistd.h>
@@ -637,9 +638,65 @@ TEST_CASE("pbrt errors name file:line and the statement or parameter") {
   }
 }
 
+TEST_CASE("pbrt PixelFilter: box and Gaussian map onto render.filter, each version's names and defaults") {
+  struct Case {
+    std::string text;
+    std::optional<std::string> filter;
+    std::optional<float> radius;
+    size_t notes;
+  };
+  const std::string world = "WorldBegin\n";
+  const std::vector<Case> cases = {
+      // No PixelFilter: tdpm's default, unless the film is pbrt-v4's (its default Gaussian 1.5).
+      {world, std::nullopt, std::nullopt, 0},
+      {"Film \"image\"\n" + world, std::nullopt, std::nullopt, 0},
+      {"Film \"rgb\"\n" + world, "gaussian", 1.5f, 0},
+      // Box: v3 xwidth, v4 xradius, default 0.5.
+      {"PixelFilter \"box\"\n" + world, "box", 0.5f, 0},
+      {"PixelFilter \"box\" \"float xwidth\" 1 \"float ywidth\" 1\n" + world, "box", 1.0f, 0},
+      {"PixelFilter \"box\" \"float xradius\" 0.75 \"float yradius\" 0.75\n" + world, "box", 0.75f, 0},
+      // Gaussian: v3 (width 2, alpha 2 = sigma 0.5) and v4 (radius 1.5, sigma 0.5).
+      {"PixelFilter \"gaussian\"\n" + world, "gaussian", 1.5f, 0},
+      {"Film \"image\"\nPixelFilter \"gaussian\"\n" + world, "gaussian", 2.0f, 0},
+      {"PixelFilter \"gaussian\" \"float alpha\" 2\n" + world, "gaussian", 2.0f, 0},
+      {"PixelFilter \"gaussian\" \"float xradius\" 1 \"float yradius\" 1 \"float sigma\" 0.5\n" + world, "gaussian", 1.0f, 0},
+      // Approximations, each a note: another sigma; unequal radii (the larger).
+      {"PixelFilter \"gaussian\" \"float sigma\" 0.8\n" + world, "gaussian", 1.5f, 1},
+      {"PixelFilter \"box\" \"float xradius\" 0.5 \"float yradius\" 1\n" + world, "box", 1.0f, 1},
+      // Unsupported kinds: tdpm's box, with a note.
+      {"PixelFilter \"triangle\" \"float xradius\" 2\n" + world, std::nullopt, std::nullopt, 1},
+  };
+  for (const Case& c : cases) {
+    INFO(c.text);
+    pbrt::ImportResult r = pbrt::importPbrtText(c.text, "f.pbrt");
+    CHECK(r.scene.render.filter == c.filter);
+    CHECK(r.scene.render.filterRadius == c.radius);
+    CHECK(r.notes.size() == c.notes);
+  }
+  // Errors name the place: a radius outside tdpm's range, both spellings at once.
+  for (const auto& [text, expected] : std::vector<std::pair<std::string, std::string>>{
+           {"PixelFilter \"box\" \"float xradius\" 40\nWorldBegin\n", "f.pbrt:1: PixelFilter \"box\": radius 40 is outside"},
+           {"PixelFilter \"gaussian\" \"float xwidth\" 2 \"float xradius\" 2\nWorldBegin\n", "f.pbrt:1"},
+           {"PixelFilter \"gaussian\" \"float bogus\" 2\nWorldBegin\n", "bogus"}}) {
+    INFO(text);
+    std::string message;
+    try {
+      pbrt::importPbrtText(text, "f.pbrt");
+    } catch (const Error& e) {
+      message = e.what();
+    }
+    CHECK(message.find(expected) != std::string::npos);
+  }
+  // The filter survives `tdpm convert`'s JSON (render.filter, filter_radius).
+  scene::SceneDescription d = pbrt::importPbrtText("PixelFilter \"gaussian\" \"float xradius\" 1.25 \"float yradius\" 1.25\nWorldBegin\n", "f.pbrt").scene;
+  nlohmann::json j = nlohmann::json::parse(pbrt::sceneToJson(d, "/tmp/f.json").json);
+  CHECK(j["render"]["filter"] == "gaussian");
+  CHECK(j["render"]["filter_radius"].get<double>() == 1.25);
+}
+
 TEST_CASE("pbrt import notes: quality-only statements and ignored mesh attributes are one line each") {
   pbrt::ImportResult r = pbrt::importPbrtText(R"(
-PixelFilter "gaussian"
+PixelFilter "mitchell" "float B" 0.3
 Accelerator "bvh"
 ColorSpace "srgb"
 WorldBegin

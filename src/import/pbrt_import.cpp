@@ -18,6 +18,8 @@
 
 #include "core/error.h"
 #include "import/pbrt_importer.h"
+#include "sampling/filter.h"
+#include "scene/limits.h"
 
 namespace tdpm::pbrt::detail {
 
@@ -152,6 +154,62 @@ void Importer::requireWorld(const Loc& at, const std::string& stmt) const {
   if (!inWorld_) failAt(at, stmt + " is only allowed after WorldBegin");
 }
 
+// PixelFilter -> render.filter / filter_radius. tdpm's filters are pbrt-v4's
+// box and Gaussian (sigma 0.5 px), square, sampled by importance
+// (sampling/filter.h). pbrt-v3 spells radii xwidth/ywidth, v4
+// xradius/yradius; v3's Gaussian exp(-alpha x^2) with its default alpha 2
+// is sigma 0.5. Without a PixelFilter: a v4 film (rgb, gbuffer, spectral)
+// means pbrt-v4, whose default is the Gaussian of radius 1.5; otherwise
+// the box of radius 0.5 (pbrt-v3's default, and tdpm's).
+void Importer::mapPixelFilter(scene::RenderSettings& r, bool v4Film) {
+  if (!pixelFilter_.given) {
+    if (v4Film) {
+      r.filter = "gaussian";
+      r.filterRadius = 1.5f;
+    }
+    return;
+  }
+  const ParamSet& ps = pixelFilter_.params;
+  const Loc& at = pixelFilter_.at;
+  const std::string& type = pixelFilter_.type;
+  bool gaussian = type == "gaussian";
+  if (type != "box" && !gaussian) {
+    for (const char* q : {"xwidth", "ywidth", "xradius", "yradius", "B", "C", "tau", "alpha", "sigma"}) ps.markUsed(q);
+    note(at, "PixelFilter \"" + type + "\" is not supported: tdpm's box filter (one pixel) is used");
+    ps.checkAllUsed();
+    return;
+  }
+  // A radius not given takes its version's default; the Gaussian's is 2 in
+  // pbrt-v3 and 1.5 in v4 (the box's 0.5 in both). The version shows in the
+  // parameter names and the film ("image" is v3's); otherwise v4.
+  bool v3 = ps.has("xwidth") || ps.has("ywidth") || ps.has("alpha") || (film_.given && film_.type == "image");
+  float fallback = gaussian ? (v3 ? 2.0f : 1.5f) : 0.5f;
+  auto radius = [&](const char* v3Name, const char* v4Name) {
+    if (ps.has(v3Name) && ps.has(v4Name))
+      ps.fail(*ps.find(v4Name), std::string("give either \"") + v3Name + "\" (pbrt-v3) or \"" + v4Name + "\" (pbrt-v4), not both");
+    return float(ps.has(v3Name) ? ps.getFloat(v3Name, fallback) : ps.getFloat(v4Name, fallback));
+  };
+  float rx = radius("xwidth", "xradius");
+  float ry = radius("ywidth", "yradius");
+  for (float v : {rx, ry})
+    if (!(v >= scene::limits::kFilterRadius.lo && v <= scene::limits::kFilterRadius.hi))
+      failAt(at, "PixelFilter \"" + type + "\": radius " + fmtNum(v) + " is outside [" + fmtNum(scene::limits::kFilterRadius.lo) +
+                     ", " + fmtNum(scene::limits::kFilterRadius.hi) + "] pixels");
+  if (rx != ry) note(at, "PixelFilter \"" + type + "\": x and y radii differ (" + fmtNum(rx) + ", " + fmtNum(ry) +
+                             "); tdpm's filters are square, the larger is used");
+  if (gaussian) {
+    if (ps.has("alpha") && ps.has("sigma")) ps.fail(*ps.find("sigma"), "give either \"alpha\" (pbrt-v3) or \"sigma\" (pbrt-v4), not both");
+    double sigma = ps.has("alpha") ? 1.0 / std::sqrt(2.0 * std::max(ps.getFloat("alpha", 2), 1e-30))
+                                   : ps.getFloat("sigma", kGaussianFilterSigma);
+    if (std::fabs(sigma - kGaussianFilterSigma) > 1e-6)
+      note(at, "PixelFilter \"gaussian\": sigma " + fmtNum(sigma) + " px is not supported (tdpm's Gaussian has sigma " +
+                   fmtNum(kGaussianFilterSigma) + "); the radius is kept");
+  }
+  ps.checkAllUsed();
+  r.filter = type;
+  r.filterRadius = std::max(rx, ry);
+}
+
 void Importer::requireOptions(const Loc& at, const std::string& stmt) const {
   if (inWorld_ || worldEnded_) failAt(at, stmt + " is only allowed before WorldBegin");
 }
@@ -236,12 +294,12 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
       if (!inv) failAt(at, "Camera: the current transform is singular");
     }
     coordSystems_["camera"] = *gs_.ctm[0].inverse();
-  } else if (s == "Film" || s == "Sampler" || s == "Integrator") {
+  } else if (s == "Film" || s == "Sampler" || s == "Integrator" || s == "PixelFilter") {
     requireOptions(at, s);
     std::string type = c.string(s);
     Statement st{type, c.params(s + " \"" + type + "\""), at, true};
-    (s == "Film" ? film_ : s == "Sampler" ? sampler_ : integrator_) = std::move(st);
-  } else if (s == "PixelFilter" || s == "Accelerator" || s == "ColorSpace") {
+    (s == "Film" ? film_ : s == "Sampler" ? sampler_ : s == "Integrator" ? integrator_ : pixelFilter_) = std::move(st);
+  } else if (s == "Accelerator" || s == "ColorSpace") {
     std::string type = c.string(s);
     c.params(s + " \"" + type + "\"");
     note(at, s + " \"" + type + "\" ignored (it only changes quality; tdpm uses its own)");
@@ -478,11 +536,13 @@ void Importer::worldBegin(const Loc& at) {
     if (spp < 1) failAt(sampler_.at, "Sampler: samples per pixel must be at least 1, got " + std::to_string(spp));
     r.spp = spp;
     for (const char* q : {"seed", "randomization", "dimensions", "jitter"}) ps.markUsed(q);
-    note(sampler_.at, "Sampler \"" + sampler_.type + "\": its pattern is replaced by tdpm's stratified sampler (same spp)");
+    note(sampler_.at, "Sampler \"" + sampler_.type + "\": its pattern is replaced by tdpm's own sampler (same spp)");
     ps.checkAllUsed();
   } else {
     r.spp = 16;  // pbrt's default pixelsamples
   }
+
+  mapPixelFilter(r, v4Film);
 
   // Integrator -> method
   std::string integ = integrator_.given ? integrator_.type : "path";

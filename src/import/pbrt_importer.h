@@ -132,6 +132,7 @@ class Importer {
   void note(const Loc& at, const std::string& what);
   void requireWorld(const Loc& at, const std::string& stmt) const;
   void requireOptions(const Loc& at, const std::string& stmt) const;
+  void mapPixelFilter(scene::RenderSettings& r, bool v4Film);
 
   GraphicsState gs_;
   std::vector<StackEntry> stack_;
@@ -147,7 +148,7 @@ class Importer {
 
   bool inWorld_ = false, sawWorld_ = false, worldEnded_ = false;
   float transformStart_ = 0, transformEnd_ = 1;
-  Statement camera_, film_, sampler_, integrator_;
+  Statement camera_, film_, sampler_, integrator_, pixelFilter_;
   Mat cameraCtm_[2];
   bool mirror_ = true;
   float shutterOpen_ = 0, shutterClose_ = 1;

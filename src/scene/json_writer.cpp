@@ -260,6 +260,12 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
   if (r.kernelSpace) render["kernel_space"] = *r.kernelSpace;
   if (r.kernelTime) render["kernel_time"] = *r.kernelTime;
   if (r.gather) render["gather"] = *r.gather;
+  if (r.sampler) render["sampler"] = *r.sampler;
+  if (r.filter) render["filter"] = *r.filter;
+  if (r.filterRadius) render["filter_radius"] = num(*r.filterRadius);
+  if (r.progressive) render["progressive"] = *r.progressive;
+  if (r.passes) render["passes"] = *r.passes;
+  if (r.timeLimit) render["time_limit"] = num(*r.timeLimit);
   root["render"] = render;
   out.json = root.dump(2) + "\n";
   return out;
