@@ -353,8 +353,9 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_option("--max-dt", a.maxDt, "twopass: largest time distance kept, seconds (default: 10% of the shutter)")
       ->check(CLI::PositiveNumber)->group(photonGroup);
   c->add_option("--kernel-footprint", a.kernelFootprint,
-                "twopass: the space-time kernel of a caustic estimate seen from the camera is at least this many times "
-                "one eye sample's share of its pixel (pixel area x shutter / spp), growing k_s up to 16x where photons "
+                "time method (twopass and 4d search): the space-time kernel of a caustic estimate seen from the camera is "
+                "at least this many times one eye sample's share of its pixel (pixel area x shutter / spp), growing k_s "
+                "(4d: k) up to 16x where photons "
                 "bunch; 0: pure k-NN, whose tiny kernels at a focused moving caustic give speckles (default 1, "
                 "docs/photon-map.md)")
       ->check(rangeOf(limits::kKernelFootprint))->group(photonGroup);

@@ -110,15 +110,16 @@ class Gatherer {
   Gatherer(const photon::KdTree& tree, const Options& options);
   const Options& options() const { return opt_; }
 
-  // minVolume: TimeTwoPass only, the smallest space-time kernel volume
-  // (scene units^2 x seconds) the query should use; 0: none (see header).
+  // minVolume: TimeTwoPass and SpaceTime4D, the smallest space-time kernel
+  // volume (scene units^2 x seconds) the query should use; 0: none (see
+  // header).
   template <class Brdf>
   Rgb radiance(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report = nullptr,
               uint8_t surfaceTag = photon::kNoSurfaceTag, float minVolume = 0.0f) {
     switch (opt_.method) {
       case Method::Standard: return standard(x, n, wo, brdf, report, surfaceTag);
       case Method::TimeTwoPass: return timeTwoPass(x, n, wo, t, brdf, report, surfaceTag, minVolume);
-      case Method::SpaceTime4D: return spaceTime4D(x, n, wo, t, brdf, report, surfaceTag);
+      case Method::SpaceTime4D: return spaceTime4D(x, n, wo, t, brdf, report, surfaceTag, minVolume);
     }
     return Rgb(0.0f);
   }
@@ -159,7 +160,7 @@ class Gatherer {
   //      V = clippedEllipsoidVolume(d^2, kappa, a, b) ----
   template <class Brdf>
   Rgb spaceTime4D(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report = nullptr,
-                  uint8_t surfaceTag = photon::kNoSurfaceTag);
+                  uint8_t surfaceTag = photon::kNoSurfaceTag, float minVolume = 0.0f);
 
  private:
   // Radius^2 of the search ball per the rule in the header comment.
@@ -321,43 +322,64 @@ Rgb Gatherer::twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf
 
 template <class Brdf>
 Rgb Gatherer::spaceTime4D(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf, Report* report,
-                          uint8_t surfaceTag) {
+                          uint8_t surfaceTag, float minVolume) {
   const photon::PhotonStore& s = tree_->store();
   const photon::TimeQuantiser& tq = s.time();
   t = std::min(std::max(t, tq.t0), tq.t1);
   float maxD2 = opt_.maxRadius * opt_.maxRadius;
-  int found = tree_->knn4(x, t, opt_.k, maxD2, query_);
+  const uint16_t* flags = s.flags();
+  const double kappa = tree_->kappa();
+  int k = opt_.k, found = 0, qmin = 255, qmax = 0;
+  float D2 = 0.0f;
+  double a = 0.0, b = 0.0, volume = 0.0;
+  // At most twice, as the two-pass estimate: the k nearest, then (if their
+  // ellipsoid is smaller than minVolume and the search was not stopped by
+  // the maximum radius) again with k grown by the missing volume ratio.
+  for (int attempt = 0;; ++attempt) {
+    found = tree_->knn4(x, t, k, maxD2, query_);
+    if (found == 0) {
+      if (report) *report = Report{};
+      return Rgb(0.0f);
+    }
+    D2 = ballRadius2(found, k, maxD2);
+    const uint32_t* idx = query_.index();
+    qmin = 255;
+    qmax = 0;
+    for (int i = 0; i < found; ++i) {
+      int q = flags[idx[i]] & photon::kTimeMask;
+      qmin = std::min(qmin, q);
+      qmax = std::max(qmax, q);
+    }
+    // Time extent of the ellipsoid, clipped to the photons' bins (whose
+    // union lies inside the shutter): s in [a, b] relative to t.
+    double half = std::sqrt(double(D2) / kappa);
+    a = std::max(-half, double(tq.binStart(qmin)) - t);
+    b = std::min(half, double(tq.binStart(qmax + 1)) - t);
+    volume = clippedEllipsoidVolume(D2, kappa, a, b);
+    if (attempt > 0 || !(volume < double(minVolume)) || !(volume > 0.0) || found < k) break;
+    const int maxK = opt_.k * std::max(1, opt_.maxGrowth);
+    const double grown = std::ceil(double(k) * double(minVolume) / volume);
+    int next = grown < double(maxK) ? int(grown) : maxK;
+    if (next <= k) break;
+    k = next;
+  }
   if (report) {
     *report = Report{};
     report->candidates = found;
     report->kept = found;
   }
-  if (found == 0) return Rgb(0.0f);
-  float D2 = ballRadius2(found, opt_.k, maxD2);
   const uint32_t* idx = query_.index();
-  const uint16_t* flags = s.flags();
   const uint16_t* dirs = s.directions();
   const uint32_t* energies = s.energies();
-  int qmin = 255, qmax = 0;
   Rgb sum(0.0f);
   for (int i = 0; i < found; ++i) {
     uint32_t p = idx[i];
-    int q = flags[p] & photon::kTimeMask;
-    qmin = std::min(qmin, q);
-    qmax = std::max(qmax, q);
     Vec3f wi = photon::decodeDirection(dirs[p]);
     if (!(dot(n, wi) > 0.0f)) continue;
     if (photon::otherSideOfSameSurface(uint8_t(flags[p] >> photon::kUserShift), surfaceTag)) continue;
     sum += brdf(wi, wo) * photon::decodeRgbe(energies[p]);
     if (report) report->used.push_back(p);
   }
-  // Time extent of the ellipsoid, clipped to the photons' bins (whose union
-  // lies inside the shutter): s in [a, b] relative to t.
-  double kappa = tree_->kappa();
-  double half = std::sqrt(double(D2) / kappa);
-  double a = std::max(-half, double(tq.binStart(qmin)) - t);
-  double b = std::min(half, double(tq.binStart(qmax + 1)) - t);
-  double volume = clippedEllipsoidVolume(D2, kappa, a, b);
   if (report) {
     report->radius2 = D2;
     report->volume = float(volume);
