@@ -11,9 +11,14 @@ Camera::Camera(const scene::CameraDesc& d)
   aspect_ = float(d.width) / float(d.height);
   if (d.motion.empty()) keys_ = {{d.shutterOpen, d.position, d.target, d.up}};
   else keys_ = d.motion;
+  if (keys_.size() == 1) stillPose_ = interpolatePose(0.0f);
 }
 
 Camera::Pose Camera::poseAt(float time01) const {
+  return keys_.size() == 1 ? stillPose_ : interpolatePose(time01);
+}
+
+Camera::Pose Camera::interpolatePose(float time01) const {
   const scene::CameraKeyframe* a = &keys_.front();
   const scene::CameraKeyframe* b = a;
   float s = 0;

@@ -29,11 +29,13 @@ class Camera {
  private:
   struct Pose { Vec3f position, forward, right, up; };
   Pose poseAt(float time01) const;
+  Pose interpolatePose(float time01) const;
 
   std::vector<scene::CameraKeyframe> keys_;
   Shutter shutter_;
   int width_ = 1, height_ = 1;
   float tanHalfFov_ = 1.0f, aspect_ = 1.0f;
+  Pose stillPose_{};  // a camera with one key: its pose, made once (every camera ray asks)
 };
 
 }  // namespace tdpm

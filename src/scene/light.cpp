@@ -16,6 +16,20 @@ float Light::spotFalloff(float cosTheta) const {
   return (d * d) * (d * d);
 }
 
+namespace {
+AreaLightFrame computeAreaLightFrame(const Light& light, float time01) {
+  Affine3f m = light.motion.atNormalized(time01);
+  AreaLightFrame f;
+  f.center = m.point({0, 0, 0});
+  f.edgeX = m.vector({light.size.x, 0, 0});
+  f.edgeZ = m.vector({0, 0, light.size.y});
+  Vec3f c = cross(f.edgeZ, f.edgeX);  // local (0,0,1) x (1,0,0) = +y; emitting side is -y
+  f.area = length(c);
+  f.normal = f.area > 0 ? -c / f.area : Vec3f(0, -1, 0);
+  return f;
+}
+}  // namespace
+
 void finalizeLight(Light& light) {
   switch (light.type) {
     case Light::Type::Point:
@@ -34,18 +48,17 @@ void finalizeLight(Light& light) {
     case Light::Type::Area:
       break;
   }
+  light.hasStillFrame = false;
+  if (light.type == Light::Type::Area && !light.motion.moving()) {
+    light.stillFrame = computeAreaLightFrame(light, 0.0f);  // a still motion is the same at every time
+    light.hasStillFrame = true;
+  }
 }
 
+
 AreaLightFrame areaLightFrame(const Light& light, float time01) {
-  Affine3f m = light.motion.atNormalized(time01);
-  AreaLightFrame f;
-  f.center = m.point({0, 0, 0});
-  f.edgeX = m.vector({light.size.x, 0, 0});
-  f.edgeZ = m.vector({0, 0, light.size.y});
-  Vec3f c = cross(f.edgeZ, f.edgeX);  // local (0,0,1) x (1,0,0) = +y; emitting side is -y
-  f.area = length(c);
-  f.normal = f.area > 0 ? -c / f.area : Vec3f(0, -1, 0);
-  return f;
+  if (light.hasStillFrame) return light.stillFrame;
+  return computeAreaLightFrame(light, time01);
 }
 
 Rgb areaLightRadiance(const Light& light, const AreaLightFrame& f, Vec3f dirFromLight) {

@@ -11,6 +11,11 @@
 
 namespace tdpm {
 
+struct AreaLightFrame {
+  Vec3f center, edgeX, edgeZ, normal;  // world, at one time; normal = emitting side
+  float area;
+};
+
 struct Light {
   enum class Type : uint8_t { Point, Spot, Directional, Area };
   Type type = Type::Point;
@@ -22,6 +27,10 @@ struct Light {
   Vec2f size{1, 1};          // area: local x-z rectangle, emits toward local -y
   Motion motion;             // light-to-world over the shutter
   uint32_t geometryId = ~0u; // area: its Embree geometry
+  // Area lights that do not move: their frame, made once by finalizeLight
+  // (areaLightFrame is asked for it at every light sample and every hit).
+  bool hasStillFrame = false;
+  AreaLightFrame stillFrame{};
 
   bool isDelta() const { return type != Type::Area; }
   // Spot falloff: 1 inside the inner cone, 0 outside the outer cone and a
@@ -29,17 +38,14 @@ struct Light {
   float spotFalloff(float cosTheta) const;
 };
 
-// Derived constants (intensity from power; spot solid-angle integral).
+// Derived constants (intensity from power; spot solid-angle integral; a
+// still area light's frame). Call it again after changing a light.
 void finalizeLight(Light& light);
 
 // A light that adds nothing to any image: zero power (irradiance for a
 // directional light) in every channel. Valid input, but worth a warning.
 inline bool emitsNothing(const Light& light) { return !(light.power.maxComponent() > 0.0f); }
 
-struct AreaLightFrame {
-  Vec3f center, edgeX, edgeZ, normal;  // world, at one time; normal = emitting side
-  float area;
-};
 AreaLightFrame areaLightFrame(const Light& light, float time01);
 // Emitted radiance of an area light toward direction -wiToLight from the
 // light's surface, when its emitting side faces it.
