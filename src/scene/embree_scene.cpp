@@ -41,20 +41,31 @@ RTCScene newScene(RTCDevice device) {
   return scene;
 }
 
-// A still triangle mesh in `scene`; errors are left on the device.
-uint32_t attachTriangles(RTCDevice device, RTCScene scene, const std::vector<Vec3f>& vertices,
-                         const std::vector<uint32_t>& indices) {
-  TDPM_ASSERT(indices.size() % 3 == 0, "bad triangle input");
+// A triangle mesh with `steps` time steps in `scene`: fillStep(step, out)
+// writes the vertexCount vertices of each step. Returns
+// RTC_INVALID_GEOMETRY_ID if Embree could not allocate a buffer (the
+// reason is left on the device).
+template <class FillStep>
+uint32_t attachTriangles(RTCDevice device, RTCScene scene, unsigned steps, size_t vertexCount,
+                         const std::vector<uint32_t>& indices, FillStep fillStep) {
+  TDPM_ASSERT(steps >= 1 && indices.size() % 3 == 0, "bad triangle input");
   RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* v = static_cast<float*>(
-      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertices.size()));
+  if (steps > 1) rtcSetGeometryTimeStepCount(g, steps);
+  for (unsigned step = 0; step < steps; ++step) {
+    auto* v = static_cast<Vec3f*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, step, RTC_FORMAT_FLOAT3, sizeof(Vec3f), vertexCount));
+    if (!v) {
+      rtcReleaseGeometry(g);
+      return RTC_INVALID_GEOMETRY_ID;
+    }
+    fillStep(step, v);
+  }
   auto* idx = static_cast<uint32_t*>(
       rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), indices.size() / 3));
-  if (!v || !idx) {
+  if (!idx) {
     rtcReleaseGeometry(g);
     return RTC_INVALID_GEOMETRY_ID;
   }
-  std::memcpy(v, vertices.data(), vertices.size() * sizeof(Vec3f));
   std::memcpy(idx, indices.data(), indices.size() * sizeof(uint32_t));
   rtcCommitGeometry(g);
   uint32_t id = rtcAttachGeometry(scene, g);
@@ -143,34 +154,28 @@ EmbreeScene::~EmbreeScene() {
 }
 
 uint32_t EmbreeScene::addTriangles(const std::vector<Vec3f>& vertices, const std::vector<uint32_t>& indices) {
-  uint32_t e = attachTriangles(impl_->device, impl_->layers[Impl::kStillMeshes].scene, vertices, indices);
+  uint32_t e = attachTriangles(impl_->device, impl_->layers[Impl::kStillMeshes].scene, 1, vertices.size(), indices,
+                               [&](unsigned, Vec3f* out) { std::copy(vertices.begin(), vertices.end(), out); });
   impl_->check("add a triangle mesh");
+  if (e == RTC_INVALID_GEOMETRY_ID) throw Error("Embree failed to allocate a triangle mesh");
   return impl_->record(Impl::kStillMeshes, e, {});
 }
 
 uint32_t EmbreeScene::addMovingTriangles(const std::vector<Vec3f>& objectVertices,
                                          const std::vector<uint32_t>& indices, const std::vector<Affine3f>& steps) {
-  TDPM_ASSERT(steps.size() >= 2 && indices.size() % 3 == 0, "bad moving mesh input");
-  RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  rtcSetGeometryTimeStepCount(g, unsigned(steps.size()));
+  TDPM_ASSERT(steps.size() >= 2, "a moving mesh needs two or more time steps");
+  // Between steps every vertex moves on the segment joining its positions
+  // at the two steps, so the box of all steps' vertices holds the mesh.
   Bounds3f swept;
-  for (size_t s = 0; s < steps.size(); ++s) {
-    auto* v = static_cast<Vec3f*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, unsigned(s), RTC_FORMAT_FLOAT3,
-                                                          sizeof(Vec3f), objectVertices.size()));
-    if (!v) { rtcReleaseGeometry(g); impl_->check("allocate a vertex buffer"); }
-    for (size_t i = 0; i < objectVertices.size(); ++i) {
-      v[i] = steps[s].point(objectVertices[i]);
-      swept.extend(v[i]);
-    }
-  }
-  auto* idx = static_cast<uint32_t*>(
-      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), indices.size() / 3));
-  if (!idx) { rtcReleaseGeometry(g); impl_->check("allocate an index buffer"); }
-  std::memcpy(idx, indices.data(), indices.size() * sizeof(uint32_t));
-  rtcCommitGeometry(g);
-  uint32_t e = rtcAttachGeometry(impl_->layers[Impl::kMovingMeshes].scene, g);
-  rtcReleaseGeometry(g);
+  uint32_t e = attachTriangles(impl_->device, impl_->layers[Impl::kMovingMeshes].scene, unsigned(steps.size()),
+                               objectVertices.size(), indices, [&](unsigned step, Vec3f* out) {
+                                 for (size_t i = 0; i < objectVertices.size(); ++i) {
+                                   out[i] = steps[step].point(objectVertices[i]);
+                                   swept.extend(out[i]);
+                                 }
+                               });
   impl_->check("add a moving mesh");
+  if (e == RTC_INVALID_GEOMETRY_ID) throw Error("Embree failed to allocate a moving mesh");
   return impl_->record(Impl::kMovingMeshes, e, swept);
 }
 
