@@ -187,7 +187,7 @@ TEST_CASE("hostile input: kappa outside what the float 4D metric computes is ref
   CHECK(r.hi == doctest::Approx(3.40282347e+38 / 4));
   CHECK(float(r.lo / 65536.0) >= 1.17549435e-38f);
   checkEdit([](Json& j) { j["render"] = {{"kappa", 1e-38}}; }, "render.kappa",
-            "kappa 1e-38 cannot be used with a shutter of 1 s: the 4D metric needs kappa in [7.7e-34, 8.51e+37] (float range)");
+            "kappa 1e-38 cannot be used with a shutter of 1 s: the 4D metric needs kappa in [7.704e-34, 8.507e+37] (float range)");
   CHECK(errorOf(edited([](Json& j) { j["render"] = {{"kappa", 1e-33}}; })) == "(no error)");
   // A zero-length shutter has no time to weigh.
   CHECK(errorOf(edited([](Json& j) {
@@ -201,7 +201,7 @@ TEST_CASE("hostile input: kappa outside what the float 4D metric computes is ref
   test::CommandResult res = test::runTdpm("render '" + scene + "' -o '" + dir.path + "/k.exr' --search 4d --kappa 1e-38 -q");
   CHECK(res.exitCode == 1);
   CHECK(res.output.find("--kappa: 1e-38 cannot be used with the 1 s shutter of " + scene +
-                        ": the 4D metric needs kappa in [7.7e-34, 8.51e+37]") != std::string::npos);
+                        ": the 4D metric needs kappa in [7.704e-34, 8.507e+37]") != std::string::npos);
   CHECK(!test::fileExists(dir.path + "/k.exr"));
 }
 

@@ -21,14 +21,17 @@ inline std::string formatG(double v) {
 
 inline CLI::Range rangeOf(scene::limits::IntRange r) { return CLI::Range(r.lo, r.hi); }
 
+// The value is checked as the float the option stores (and the scene key
+// reads): compared in double, "0.001" was below its own bound 1e-3f.
 inline CLI::Validator rangeOf(scene::limits::FloatRange r) {
-  std::string range = formatG(r.lo) + " to " + formatG(r.hi);
+  std::string range = scene::limits::rangeText(r);
   return CLI::Validator(
       [r, range](std::string& text) -> std::string {
         char* end = nullptr;
         double v = std::strtod(text.c_str(), &end);
         if (end == text.c_str() || *end != '\0') return "expected a number, got '" + text + "'";
-        if (!(v >= r.lo && v <= r.hi)) return "Value " + text + " not in range " + range;
+        float f = float(v);
+        if (!(f >= r.lo && f <= r.hi)) return "Value " + text + " not in range " + range;
         return "";
       },
       "FLOAT in [" + range + "]");

@@ -5,6 +5,9 @@
 // apart. docs/scene-format.md ("Limits") is the user-facing version.
 #pragma once
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
 
 namespace tdpm::scene::limits {
 
@@ -91,5 +94,23 @@ inline KappaRange kappaRange(double shutterLength) {
   double bin = shutterLength / kTimeBins;
   return {floatMin / (bin * bin), floatMax / 4 / (shutterLength * shutterLength)};
 }
+
+// The text of a range's end point for messages, help and docs: the shortest
+// "%.Ng" (N >= 3) that the range itself accepts when typed back, so that a
+// message never names a bound that is refused (kappa's lower bound for 1 s
+// is 7.7037e-34: "7.7e-34" is below it, so it reads "7.704e-34"). `asFloat`:
+// the check rounds the typed value to float first, as flags and scene keys
+// stored in float do (1e-3f is 0.0010000000475: "0.001" must be accepted).
+inline std::string boundText(double bound, bool lower, bool asFloat) {
+  char buf[40] = "";
+  for (int digits = 3; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, bound);
+    double typed = std::strtod(buf, nullptr);
+    if (asFloat) typed = double(float(typed));
+    if (lower ? typed >= bound : typed <= bound) break;
+  }
+  return buf;
+}
+inline std::string rangeText(FloatRange r) { return boundText(r.lo, true, true) + " to " + boundText(r.hi, false, true); }
 
 }  // namespace tdpm::scene::limits

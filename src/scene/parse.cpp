@@ -45,12 +45,6 @@ struct Shutter {
 };
 
 std::string fmt(double v) { return formatNumber(v); }
-// 3 significant digits, for computed bounds.
-std::string fmt3(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
 
 // The member if present, else the object: where to point an error about a
 // value that may have come from a default.
@@ -645,7 +639,8 @@ int readCount(const Node& n, const char* what, limits::IntRange r) { return int(
 
 float readFloatInRange(const Node& n, const char* what, limits::FloatRange r) {
   float v = n.number();
-  n.require(v >= r.lo && v <= r.hi, std::string(what) + " must be in [" + fmt(r.lo) + ", " + fmt(r.hi) + "], got " + fmt(v));
+  n.require(v >= r.lo && v <= r.hi, std::string(what) + " must be in [" + limits::boundText(r.lo, true, true) + ", " +
+                                         limits::boundText(r.hi, false, true) + "], got " + fmt(v));
   return v;
 }
 
@@ -655,8 +650,9 @@ float readKappa(const Node& n, float shutterLength) {
   float kappa = readPositive(n, "kappa");
   limits::KappaRange r = limits::kappaRange(shutterLength);
   n.require(kappa >= r.lo && kappa <= r.hi, "kappa " + fmt(kappa) + " cannot be used with a shutter of " +
-                                                fmt(shutterLength) + " s: the 4D metric needs kappa in [" + fmt3(r.lo) +
-                                                ", " + fmt3(r.hi) + "] (float range)");
+                                                fmt(shutterLength) + " s: the 4D metric needs kappa in [" +
+                                                limits::boundText(r.lo, true, true) + ", " +
+                                                limits::boundText(r.hi, false, true) + "] (float range)");
   return kappa;
 }
 
