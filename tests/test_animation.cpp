@@ -18,6 +18,7 @@
 #include "render/animation.h"
 #include "render/renderer.h"
 #include "scene/parse.h"
+#include "scene/parse_animation.h"
 #include "scene/scene.h"
 #include "moving_plane.h"
 #include "scene_fixtures.h"
@@ -477,4 +478,138 @@ TEST_CASE("render CLI: with --window, peak memory does not grow with the number 
   MESSAGE("peak RSS: 12 frames " << peak[0] / 1024 << " KiB, 48 frames " << peak[1] / 1024 << " KiB");
   // Holding the 36 extra frames would add about 9 MB; allow 4 MB of noise.
   CHECK(peak[1] < peak[0] + (uint64_t(4) << 20));
+}
+
+// Issue 27 item 15: one frame of a 2000-frame animation with --window
+// 100000 was budgeted as if 100002 frames' photons were held at once
+// ("asks for 2438164000 caustic photons (93 GiB)" from 20000 asked for).
+TEST_CASE("render CLI: --window is capped at the frames rendered; a budget error it causes names it") {
+  std::string dir = test::makeTempDir();
+  std::string scene = writeScene(dir, "long.json", R"({"animation": {"fps": 24, "frames": 2000},
+ "camera": {"position": [0, 1.5, 4], "target": [0, 0, 0], "resolution": [8, 6]},
+ "objects": [{"shape": {"type": "quad", "size": [6, 6]}}],
+ "lights": [{"type": "point", "position": [0, 3, 0], "power": [200, 200, 200],
+   "motion": [{"time": 0, "translate": [-1, 0, 0]}, {"time": 83, "translate": [1, 0, 0]}]}]})");
+  // Uncapped: 20000 x (100002 x 156/128 + 1) = 2.4e9 photons, far above this machine's memory.
+  auto one = test::runTdpm("render '" + scene + "' -o '" + dir + "/one.exr' --frame-range 7-7 --window 100000 "
+                           "--spp 1 --photons 0 --global-photons 20000 --global-direct -t 2 -q");
+  INFO(one.output);
+  CHECK(one.exitCode == 0);
+  CHECK(test::fileExists(dir + "/one.exr"));
+  // All 2000 frames in one window of 2e6 photons each: refused before any
+  // tracing, and the message says the window multiplied the count.
+  auto all = test::runTdpm("render '" + scene + "' -o '" + dir + "/all/f_####.exr' --window 100000 "
+                           "--spp 1 --photons 0 --global-photons 2000000 --global-direct -t 2 -q");
+  INFO(all.output);
+  CHECK(all.exitCode == 1);
+  CHECK(all.output.find("--global-photons (2000000 per frame, held for a window of 2000 frames at once (--window 100000))") !=
+        std::string::npos);
+  CHECK_FALSE(test::fileExists(dir + "/all/f_0000.exr"));
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
+namespace {
+
+// makeTimeGrid as it was before issue 27 (a count down from 256 / share):
+// the reference for the bisection, at angles where counting is quick.
+TimeGrid countedTimeGrid(const scene::AnimationDesc& a, double reach) {
+  reach = std::clamp(reach, 0.0, 1.0);
+  const double share = a.shutterAngle / 360.0;
+  auto fits = [&](int64_t B, TimeGrid& g) {
+    int64_t S = std::max<int64_t>(1, std::llround(double(B) * share));
+    int64_t P = int64_t(std::ceil(reach * double(S))) + 1;
+    if (S + 2 * P > 256) return false;
+    g.binsPerFrame = B;
+    g.shutterBins = S;
+    g.padBins = P;
+    g.binWidth = 1.0 / (double(B) * a.fps);
+    return true;
+  };
+  TimeGrid best;
+  int64_t B = int64_t(std::floor(256.0 / share));
+  while (B > 1 && !fits(B, best)) --B;
+  if (B <= 1) fits(1, best);
+  for (int64_t b = B; b >= std::max<int64_t>(1, B / 2); --b) {
+    TimeGrid g;
+    if (fits(b, g) && std::fabs(double(b) * share - double(g.shutterBins)) < 1e-6) return g;
+  }
+  return best;
+}
+
+std::string animationError(const std::string& animation) {
+  try {
+    scene::parseScene(animatedJson(animation, "", 0.001), "anim.json");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+}  // namespace
+
+TEST_CASE("animation time grid: the bisection finds the grid the count down found, for every angle and reach") {
+  int checked = 0;
+  for (double angle = 0.5; angle <= 360.0; angle += angle < 10 ? 0.25 : 1.7) {
+    for (double reach : {0.0, 0.1, double(RenderOptions{}.maxDtFraction), 0.37, 1.0}) {
+      scene::AnimationDesc a{24.0, 10, angle};
+      TimeGrid fast = makeTimeGrid(a, reach), slow = countedTimeGrid(a, reach);
+      INFO("angle " << angle << " reach " << reach);
+      CHECK(fast.binsPerFrame == slow.binsPerFrame);
+      CHECK(fast.shutterBins == slow.shutterBins);
+      CHECK(fast.padBins == slow.padBins);
+      CHECK(fast.binWidth == slow.binWidth);
+      ++checked;
+    }
+  }
+  CHECK(checked > 1000);
+  // A 1e-6 degree shutter: 256 / share is 9.2e10, which the count down
+  // walked one B at a time; the grid still fits (a single frame is usable).
+  TimeGrid tiny = makeTimeGrid(scene::AnimationDesc{24.0, 1, 1e-6}, 0.1);
+  CHECK(tiny.shutterBins + 2 * tiny.padBins <= 256);
+  CHECK(tiny.shutterBins >= 200);
+}
+
+// Issue 27 item 2: tiny shutter angles looped, failed inside, or said "out
+// of memory"; long timelines lost the shutter to float rounding.
+TEST_CASE("animation block: a shutter float time cannot resolve is refused at shutter_angle, with the smallest usable angle") {
+  for (const char* angle : {"1e-6", "1e-5", "1e-20"}) {
+    std::string e = animationError(std::string(R"({"fps": 24, "frames": 4, "shutter_angle": )") + angle + "}");
+    INFO(angle << " -> " << e);
+    CHECK(e.find("anim.json:") == 0);
+    CHECK(e.find("animation.shutter_angle") != std::string::npos);
+    CHECK(e.find(std::string(angle) == "1e-20" ? "below tdpm's shortest shutter of 1e-12 s" : "cannot resolve") !=
+          std::string::npos);
+    CHECK(e.find("the smallest usable shutter_angle for this fps and frame count is ") != std::string::npos);
+  }
+  // One frame near t = 0: a 1e-17 degree shutter (1.2e-21 s) traced photons
+  // for ever, 1e-30 degrees ran out of memory; below 1e-12 s is refused.
+  for (const char* angle : {"1e-17", "1e-30"})
+    CHECK(animationError(std::string(R"({"fps": 24, "frames": 1, "shutter_angle": )") + angle + "}")
+              .find("below tdpm's shortest shutter of 1e-12 s; the smallest usable shutter_angle for this fps and "
+                    "frame count is 8.64e-09") != std::string::npos);
+  CHECK(animationError(R"({"fps": 24, "frames": 1, "shutter_angle": 8.64e-09})") == "(no error)");
+  // The named smallest angle is accepted, and a little less is not.
+  std::string e = animationError(R"({"fps": 24, "frames": 100, "shutter_angle": 1e-4})");
+  const std::string key = "smallest usable shutter_angle for this fps and frame count is ";
+  size_t at = e.find(key);
+  REQUIRE(at != std::string::npos);
+  double smallest = std::strtod(e.c_str() + at + key.size(), nullptr);
+  CHECK(smallest > 0.5);
+  CHECK(smallest < 2);
+  char text[40];
+  std::snprintf(text, sizeof text, "%.17g", smallest);
+  CHECK(animationError(std::string(R"({"fps": 24, "frames": 100, "shutter_angle": )") + text + "}") == "(no error)");
+  std::snprintf(text, sizeof text, "%.17g", smallest * 0.5);
+  CHECK(animationError(std::string(R"({"fps": 24, "frames": 100, "shutter_angle": )") + text + "}") != "(no error)");
+  // The most frames at the given angle, and the limits docs/animation.md quotes (24 fps).
+  for (auto [angle, most] : {std::pair{180.0, 24575}, std::pair{10.0, 1536}, std::pair{1.0, 96}}) {
+    INFO("angle " << angle);
+    CHECK(scene::animationTimeResolutionProblem(scene::AnimationDesc{24.0, most, angle}) == "");
+    std::string p = scene::animationTimeResolutionProblem(scene::AnimationDesc{24.0, most + 1, angle});
+    CHECK(p.find("or at most " + std::to_string(most) + " frames at this angle") != std::string::npos);
+  }
+  // Frame 99999 of 100000 at 10 degrees (rendered 1.2% dark before): refused.
+  CHECK(scene::animationTimeResolutionProblem(scene::AnimationDesc{24.0, 100000, 10.0}) != "");
+  // One frame of a tiny shutter sits near t = 0, where floats are fine.
+  CHECK(scene::animationTimeResolutionProblem(scene::AnimationDesc{24.0, 1, 1e-4}) == "");
 }

@@ -119,16 +119,30 @@ TimeGrid makeTimeGrid(const scene::AnimationDesc& a, double reach) {
     g.binWidth = 1.0 / (double(B) * a.fps);
     return true;
   };
-  TimeGrid best;
-  int64_t top = int64_t(std::floor(double(photon::kTimeBins) / share));
-  int64_t B = top;
-  while (B > 1 && !fits(B, best)) --B;
-  if (B <= 1) fits(1, best);
+  // fits(B) is monotone (S grows with B, and S + 2P with S): the largest B
+  // that fits is found by bisection, not by counting down from 256 / share
+  // (issue 27 item 2: ~9e10 steps for a 1e-6 degree shutter).
+  const int64_t top = std::max<int64_t>(1, int64_t(std::min(std::floor(double(photon::kTimeBins) / share), 9e15)));
+  TimeGrid best, g;
+  int64_t lo = 1, hi = top;  // fits(lo) holds (S = 1); find the largest B in [lo, hi] that fits
+  if (fits(hi, g)) lo = hi;
+  while (hi - lo > 1) {
+    int64_t mid = lo + (hi - lo) / 2;
+    (fits(mid, g) ? lo : hi) = mid;
+  }
+  const int64_t B = lo;
+  fits(B, best);
   // Prefer a B (down to half the largest) whose shutter is whole bins:
-  // then the standard estimate's photons are exactly the shutter's.
-  for (int64_t b = B; b >= std::max<int64_t>(1, B / 2); --b) {
-    TimeGrid g;
-    if (fits(b, g) && std::fabs(double(b) * share - double(g.shutterBins)) < 1e-6) return g;
+  // then the standard estimate's photons are exactly the shutter's. Every
+  // B below the largest fits; the candidates are the b near m / share for
+  // each whole shutter m, largest first (what a count down from B finds).
+  const int64_t bLow = std::max<int64_t>(1, B / 2);
+  auto whole = [&](int64_t b) { return std::fabs(double(b) * share - double(std::max<int64_t>(1, std::llround(double(b) * share)))) < 1e-6; };
+  for (int64_t m = std::llround(double(B) * share); m >= 1 && double(m) >= double(bLow) * share - 1; --m) {
+    int64_t b1 = std::min(B, int64_t(std::floor((double(m) + 1e-6) / share)) + 1);
+    int64_t b0 = std::max(bLow, int64_t(std::ceil((double(m) - 1e-6) / share)) - 1);
+    for (int64_t b = b1; b >= b0; --b)
+      if (whole(b) && fits(b, g)) return g;
   }
   return best;
 }
@@ -147,14 +161,24 @@ AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& a
   const bool wantGlobal = opt.visualizeGlobal || opt.gatherRays > 0;
   const bool spaceTime = opt.spaceTime4D && opt.method == "time" && scene.hasMotion;
   const size_t total = size_t(ao.last - ao.first + 1);
+  // A window wider than the frames rendered holds nothing more (issue 27
+  // item 15: one frame with --window 100000 was budgeted for 100002 frames'
+  // photons). Frames' photons do not depend on the window, so capping it
+  // changes no image.
+  const int window = int(std::min<int64_t>(ao.window, int64_t(total)));
 
   // Memory: the window's segments (each frame's shutter and pads) and one
   // frame's two copies of its maps, at --photons per shutter.
   if (photons) {
     RenderOptions held = opt;
-    double factor = double(ao.window + 2) * double(grid.shutterBins + 2 * grid.padBins) / double(grid.shutterBins) + 1.0;
+    double factor = double(window + 2) * double(grid.shutterBins + 2 * grid.padBins) / double(grid.shutterBins) + 1.0;
     held.causticPhotons = size_t(double(opt.causticPhotons) * factor);
     held.globalPhotons = wantGlobal ? size_t(double(opt.globalPhotons) * factor) : 0;
+    // The budget's message names what multiplied the scene's counts.
+    const std::string times = " per frame, held for a window of " + std::to_string(window) +
+                              " frames at once (--window " + std::to_string(ao.window) + ")";
+    held.causticPhotonsSource = opt.causticPhotonsSource + " (" + std::to_string(opt.causticPhotons) + times + ")";
+    held.globalPhotonsSource = opt.globalPhotonsSource + " (" + std::to_string(opt.globalPhotons) + times + ")";
     checkMemoryBudget(scene, held, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
   } else {
     checkMemoryBudget(scene, opt, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
@@ -199,8 +223,8 @@ AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& a
   std::map<int64_t, Segment> held;  // by lo
   uint64_t emitted = 0;
   progress.at(WorkPosition{"frame", 0, total, 0, 0});
-  for (int w0 = ao.first; w0 <= ao.last; w0 += ao.window) {
-    const int w1 = std::min(ao.last, w0 + ao.window - 1);
+  for (int w0 = ao.first; w0 <= ao.last; w0 += window) {
+    const int w1 = std::min(ao.last, w0 + window - 1);
     // Trace the segments this window's frames need that are not held yet.
     Timer traceTimer;
     if (photons)
