@@ -7,6 +7,7 @@
 #include <doctest/doctest.h>
 
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -256,6 +257,71 @@ TEST_CASE("mpi: a bad scene is reported once and every rank exits 1") {
   CHECK(occurrences(r.output, "bad.json:1: camera: expected an object") == 1);
   CHECK(occurrences(r.output, "rank-exit 1") == 2);
   CHECK_FALSE(test::fileExists(dir + "/bad.exr"));
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
+// `mpirun -np 1 tdpm A : -np 1 tdpm B` (MPMD): rank 0 runs `args0` in
+// directory `cd0`, rank 1 `args1` in `cd1`, each through sh to print its
+// own exit status.
+static CommandResult runMpmd(const std::string& args0, const std::string& args1, const std::string& cd0 = ".",
+                      const std::string& cd1 = ".") {
+  auto rank = [](const std::string& cd, const std::string& args) {
+    return "-np 1 sh -c \"cd '" + cd + "' && '" + TDPM_BINARY + "' " + args + "; echo rank-exit \\$?\"";
+  };
+  return test::runShell("OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 '" +
+                        std::string(TDPM_MPIEXEC) + "' --oversubscribe " + rank(cd0, args0) + " : " + rank(cd1, args1));
+}
+
+// Issue 27 item 1: ranks started with other scenes or options spun for ever
+// in collectives of other shapes, or mixed their images silently.
+TEST_CASE("mpi: ranks with another scene or other options stop with one error naming the rank and what differs") {
+  std::string dir = test::makeTempDir();
+  const std::string scenes = std::string(TDPM_SOURCE_DIR) + "/scenes/";
+  const std::string common = " --spp 1 --photons 2000 --global-photons 500 -t 1 -q -o '" + dir + "/x.exr'";
+  const std::string cube = "render '" + scenes + "cube-caustic.json' --resolution 16x12" + common;
+  const std::string cube3000 = "render '" + scenes + "cube-caustic.json' --resolution 16x12 --spp 1 --photons 3000 "
+                               "--global-photons 500 -t 1 -q -o '" + dir + "/x.exr'";
+  auto check = [&](const CommandResult& r, const std::string& what) {
+    INFO(r.output);
+    CHECK(r.exitCode != 124);  // no hang
+    CHECK(occurrences(r.output, "tdpm: error: the ranks of this mpirun job do not render the same thing: rank 1 "
+                                "differs from rank 0 in ") == 1);
+    CHECK(occurrences(r.output, what) == 1);
+    CHECK(occurrences(r.output, "rank-exit 1") == 2);
+    CHECK_FALSE(test::fileExists(dir + "/x.exr"));
+  };
+  check(runMpmd(cube + " --seed 7", "render '" + scenes + "glass-ball.json' --resolution 16x12 --seed 7" + common),
+        "the scene (" + scenes + "cube-caustic.json on rank 0, " + scenes + "glass-ball.json on rank 1)");
+  check(runMpmd(cube + " --seed 7", cube + " --seed 8"), "the options seed (7 on rank 0, 8 on rank 1)");
+  check(runMpmd(cube + " --seed 7", cube3000 + " --seed 7"), "the options photons (2000 on rank 0, 3000 on rank 1)");
+  // A usage error on one rank alone (it stopped before any collective and
+  // the other waited for ever): the ranks agree on it first.
+  CommandResult usage = runMpmd(cube + " --seed 7", cube + " --seed 7 --photons 3000");
+  INFO(usage.output);
+  CHECK(usage.exitCode != 124);
+  CHECK(occurrences(usage.output, "tdpm: rank 1: --photons: At Most 1 required but received 2") == 1);
+  CHECK(occurrences(usage.output, "rank-exit 2") == 2);
+  check(runMpmd(cube + " --seed 7",
+                "render '" + scenes + "cube-caustic.json' --resolution 20x12 --seed 7 -m standard" + common),
+        "the options method (time on rank 0, standard on rank 1), resolution (16x12 on rank 0, 20x12 on rank 1)");
+  // A stale copy of the scene under the same name (a brighter light).
+  std::string scene = readText(scenes + "cube-caustic.json"), stale = scene;
+  size_t power = stale.find("\"power\": [");
+  REQUIRE(power != std::string::npos);
+  stale.insert(power + 10, "1");  // [160, ...] -> [1160, ...]
+  ::mkdir((dir + "/a").c_str(), 0755);
+  ::mkdir((dir + "/b").c_str(), 0755);
+  test::writeFile(dir + "/a/s.json", scene);
+  test::writeFile(dir + "/b/s.json", stale);
+  const std::string local = "render s.json --resolution 16x12 --seed 7" + common;
+  check(runMpmd(local, local, dir + "/a", dir + "/b"),
+        "the scene (s.json on rank 0, s.json on rank 1: another copy or version of the file)");
+  // The same scene and options in other places: renders (the check can pass).
+  test::writeFile(dir + "/b/s.json", scene);
+  CommandResult same = runMpmd(local, local, dir + "/a", dir + "/b");
+  CHECK_MESSAGE(same.exitCode == 0, same.output);
+  CHECK(occurrences(same.output, "rank-exit 0") == 2);
+  CHECK(test::fileExists(dir + "/x.exr"));
   std::system(("rm -rf '" + dir + "'").c_str());
 }
 

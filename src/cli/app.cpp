@@ -10,6 +10,7 @@
 #include <exception>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "cli/compare_command.h"
 #include "cli/convert_command.h"
@@ -66,15 +67,45 @@ int run(int argc, char** argv) {
   CLI::App* convert = addConvertCommand(app, convertArgs);
 
   dist::Comm& comm = dist::world();
+  // Help / version (exit 0) or the usage error (every usage error exits 2,
+  // whatever CLI11's own code for it), printed into `out` / `err` first.
+  std::ostringstream out, err;
+  int code = -1;  // parsed
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    // Prints help / version (exit 0) or the usage error; every usage error
-    // exits 2, whatever CLI11's own code for it. Under mpirun every rank
-    // parses the same arguments; rank 0 alone prints.
-    std::ostringstream quiet;
-    int code = comm.root() ? app.exit(e) : app.exit(e, quiet, quiet);
-    return code == 0 ? 0 : 2;
+    code = app.exit(e, out, err) == 0 ? 0 : 2;
+  }
+  if (comm.distributed()) {
+    // Under mpirun the ranks may have been given other arguments (MPMD,
+    // `mpirun -np 1 tdpm A : -np 1 tdpm B`): a rank that stopped here alone
+    // left the others waiting for it for ever (issue 27 item 1). The ranks
+    // agree first: when any of them stopped, rank 0 prints the lowest such
+    // rank's output (named when it is not rank 0) and every rank returns its code.
+    std::vector<uint64_t> stopped = comm.allgather(code < 0 ? 0 : uint64_t(code) + 1);
+    int first = -1;
+    for (size_t r = 0; r < stopped.size() && first < 0; ++r)
+      if (stopped[r]) first = int(r);
+    if (first >= 0) {
+      std::string text = comm.rank() == first ? out.str() + '\0' + err.str() : std::string();
+      uint64_t n = text.size();
+      comm.broadcast(&n, sizeof n, first);
+      text.resize(size_t(n));
+      if (n > 0) comm.broadcast(&text[0], n, first);
+      if (comm.root()) {
+        size_t cut = text.find('\0');
+        std::string o = text.substr(0, cut), e = cut == std::string::npos ? std::string() : text.substr(cut + 1);
+        std::string who = first != 0 ? "tdpm: rank " + std::to_string(first) + ": " : std::string();
+        if (!o.empty()) std::fprintf(stdout, "%s%s", who.c_str(), o.c_str());
+        if (!e.empty()) std::fprintf(stderr, "%s%s", who.c_str(), e.c_str());
+        std::fflush(stdout);
+      }
+      return int(stopped[size_t(first)] - 1);
+    }
+  } else if (code >= 0) {
+    std::fputs(out.str().c_str(), stdout);
+    std::fputs(err.str().c_str(), stderr);
+    return code;
   }
 
   if (render->parsed()) return runReporting([&] { return runRender(renderArgs); }, comm, true);
@@ -85,8 +116,8 @@ int run(int argc, char** argv) {
     if (convert->parsed()) return runConvert(convertArgs);
     return 0;
   };
-  int code = comm.root() ? runReporting(other, comm, false) : 0;
-  return comm.distributed() ? comm.broadcastInt(code) : code;
+  int status = comm.root() ? runReporting(other, comm, false) : 0;
+  return comm.distributed() ? comm.broadcastInt(status) : status;
 }
 
 }  // namespace tdpm::cli

@@ -19,6 +19,7 @@
 #include "cli/frame_pattern.h"
 #include "cli/path_names.h"
 #include "cli/progress_bar.h"
+#include "cli/rank_agreement.h"
 #include "cli/resume.h"
 #include "render/progressive_io.h"
 #include "cli/progressive_options.h"
@@ -250,7 +251,9 @@ RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc,
 // differ from what was asked. Said before the render.
 std::vector<std::string> accumulationSppWarnings(const RenderOptions& o, bool hasMotion) {
   std::vector<std::string> w;
-  if (o.method != "accumulation" || !hasMotion || o.frames <= 1) return w;
+  // A progressive accumulation renders one time per pass, not frames (issue
+  // 27 item 16: it warned of "8 frames" while 2 passes took 2 spp).
+  if (o.method != "accumulation" || o.progressive || !hasMotion || o.frames <= 1) return w;
   int batch = std::max(1, o.spp / o.frames);
   int maxBatch = std::max(batch, std::max(o.spp, o.maxSpp) / o.frames);
   if (batch * o.frames != o.spp || (o.maxSpp > o.spp && maxBatch * o.frames != o.maxSpp))
@@ -266,7 +269,7 @@ std::vector<std::string> accumulationSppWarnings(const RenderOptions& o, bool ha
 // After the render: every frame's photon pass emits at least one batch of
 // paths, so many frames with few photons each store more than asked.
 void warnAccumulationPhotons(const RenderOptions& o, bool hasMotion, const RenderStats& st) {
-  if (o.method != "accumulation") return;
+  if (o.method != "accumulation" || o.progressive) return;
   const int frames = hasMotion ? std::max(1, o.frames) : 1;
   auto check = [&](const char* kind, size_t asked, size_t stored) {
     if (asked > 0 && double(stored) > 1.1 * double(asked))
@@ -346,7 +349,7 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
       ->check(rangeOf(limits::kK))->group(photonGroup);
   c->add_option("--fraction", a.fraction, "twopass: fraction of the k_s kept nearest in time (default 0.5)")
       ->check(rangeOf(limits::kFraction))->group(photonGroup);
-  c->add_option("--kappa", a.kappa, "4d: weight of time in the metric d^2 = |dx|^2 + kappa dt^2 (default 1; for a 1 s shutter at least 7.7e-34 and at most 8.5e37, see docs/scene-format.md)")
+  c->add_option("--kappa", a.kappa, "4d: weight of time in the metric d^2 = |dx|^2 + kappa dt^2 (default 1; for a 1 s shutter at least 7.704e-34 and at most 8.507e37, see docs/scene-format.md)")
       ->check(CLI::PositiveNumber)->group(photonGroup);
   c->add_option("--max-radius", a.maxRadius, "Largest search radius, scene units (default 2% of the scene's diagonal, the diagonal clipped to 20x the camera's distance to its target)")
       ->check(rangeOf(limits::kMaxRadius))->group(photonGroup);
@@ -431,7 +434,8 @@ int runRender(const RenderArgs& a) {
       char msg[200];
       std::snprintf(msg, sizeof msg, "--kappa: %g cannot be used with the %g s shutter of ", double(*a.kappa),
                     shutterLength);
-      throw Error(msg + a.scene + ": the 4D metric needs kappa in [" + formatG(r.lo) + ", " + formatG(r.hi) +
+      throw Error(msg + a.scene + ": the 4D metric needs kappa in [" + limits::boundText(r.lo, true, true) + ", " +
+                  limits::boundText(r.hi, false, true) +
                   "] (float range)");
     }
   }
@@ -457,6 +461,10 @@ int runRender(const RenderArgs& a) {
     setupError = e.what();
   }
   dist::raiseIfAnyFailed(comm, setupError);
+  // Under mpirun: the same scene and options on every rank, or one error
+  // before any collective whose shape depends on them (cli/rank_agreement.h).
+  requireRanksAgree(comm, comm.distributed() ? rankSettings(a, desc, opt, exposure) : std::map<std::string, std::string>{},
+                    a.scene);
 
   // A progressive render starts from the state --resume names (checked
   // against this scene and these options before any work) or from an empty
@@ -490,11 +498,10 @@ int runRender(const RenderArgs& a) {
                 " needs an animation, but " + a.scene + " has no \"animation\" block (docs/scene-format.md)");
 
   ThreadLimit limit(a.threads);
-  // Under mpirun a rank's stderr is a pipe even on a terminal, but Open MPI
-  // gives its stdout a pty when mpirun's own output is a terminal: that
-  // decides for rank 0 (the bar still draws on stderr).
-  bool showBar = ProgressBar::shouldShow(a.quiet) || (comm.distributed() && !a.quiet && isatty(STDOUT_FILENO) == 1);
-  ProgressBar bar(comm.root() && showBar);
+  // Under mpirun rank 0 draws on its stdout pty, never on the stderr pipe
+  // (ProgressBar::stream).
+  std::FILE* barStream = ProgressBar::stream(a.quiet, comm.distributed());
+  ProgressBar bar(comm.root() && barStream, barStream ? barStream : stderr);
   if (comm.root())
     for (const std::string& w : accumulationSppWarnings(opt, scene->hasMotion))
       std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
@@ -504,7 +511,7 @@ int runRender(const RenderArgs& a) {
   // mpirun all but SIGUSR1 drop the round in flight (render/progressive.cpp).
   if (opt.progressive) signals::setMode(signals::Mode::Stop);
   signals::setStopNotice(comm.root());
-  bool passLines = opt.progressive && !a.quiet && !ProgressBar::shouldShow(a.quiet);
+  bool passLines = opt.progressive && !a.quiet && !barStream;
   Film film = opt.progressive ? renderProgressive(*scene, opt, progressiveState,
                                                   passLines ? withPassLines(bar.progress()) : bar.progress(), stats,
                                                   comm)
