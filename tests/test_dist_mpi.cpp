@@ -325,6 +325,38 @@ TEST_CASE("mpi: ranks with another scene or other options stop with one error na
   std::system(("rm -rf '" + dir + "'").c_str());
 }
 
+// Issue 27 item 16: with mpirun on a terminal and its stderr redirected,
+// the bar's \r and ESC[K went into the redirected file. script(1) gives
+// mpirun a terminal; its stderr goes to err.log. No rank can tell what
+// mpirun's output is (a rank's stdout is a pty either way): no bar.
+TEST_CASE("mpi: no progress bar under mpirun, neither in a redirected stderr nor on the terminal") {
+  if (std::system("command -v script > /dev/null 2>&1") != 0) {
+    MESSAGE("script(1) not found: skipped");
+    return;
+  }
+  std::string dir = test::makeTempDir();
+  std::string job = "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 '" + std::string(TDPM_MPIEXEC) +
+                    "' --oversubscribe -np 2 '" + TDPM_BINARY + "' render '" + TDPM_SOURCE_DIR +
+                    "/scenes/cube-caustic.json' -m time --resolution 32x24 --spp 2 --photons 3000 --global-photons "
+                    "1000 -t 1 -o '" + dir + "/x.exr' 2> '" + dir + "/err.log'";
+  CommandResult r = test::runShell("timeout 120 script -qfec \"" + job + "\" '" + dir + "/typescript' > /dev/null");
+  REQUIRE_MESSAGE(r.exitCode == 0, r.output);
+  std::string err = readText(dir + "/err.log"), term = readText(dir + "/typescript");
+  INFO("stderr: " << err);
+  CHECK(err.find("time on 2 ranks: 32x24") != std::string::npos);  // the summary still goes to stderr
+  CHECK(err.find('\r') == std::string::npos);
+  CHECK(err.find("\x1b[K") == std::string::npos);
+  CHECK(term.find("\x1b[K") == std::string::npos);
+  // A progressive job prints a line per pass instead.
+  CommandResult passes = test::runShell("timeout 120 script -qfec \"" + job + " --progressive --passes 2\" '" + dir +
+                                        "/typescript2' > /dev/null");
+  REQUIRE_MESSAGE(passes.exitCode == 0, passes.output);
+  std::string log = readText(dir + "/err.log");
+  CHECK(log.find("tdpm: pass 2 of 2 done") != std::string::npos);
+  CHECK(log.find('\r') == std::string::npos);
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
 TEST_CASE("mpi: a rank that fails alone while loading is named, once, and every rank exits 1") {
   std::string dir = test::makeTempDir();
   CommandResult r = runMpi(2, "TDPM_DIST_TEST_FAIL=1:load",

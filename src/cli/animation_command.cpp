@@ -206,7 +206,8 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
   // assembles the video once every rank has finished (docs/distributed.md).
   uint64_t blockLo = 0, blockHi = 0;
   dist::blockRange(uint64_t(range.count()), comm.rank(), comm.size(), blockLo, blockHi);
-  ProgressBar bar(comm.root() && ProgressBar::shouldShow(a.quiet));
+  std::FILE* barStream = ProgressBar::stream(a.quiet, comm.distributed());  // none under mpirun
+  ProgressBar bar(comm.root() && barStream, barStream ? barStream : stderr);
   auto scene = Scene::build(descIn);
   AnimationOptions ao;
   ao.first = range.first + int(blockLo);

@@ -181,6 +181,10 @@ ProgressBar::~ProgressBar() { finish(); }
 
 bool ProgressBar::shouldShow(bool quiet) { return !quiet && ::isatty(STDERR_FILENO) == 1; }
 
+std::FILE* ProgressBar::stream(bool quiet, bool distributed) {
+  return !distributed && shouldShow(quiet) ? stderr : nullptr;
+}
+
 Progress ProgressBar::progress() {
   Progress p;
   if (enabled_) {

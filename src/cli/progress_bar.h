@@ -101,6 +101,14 @@ class ProgressBar {
 
   // The policy of issue 2: show when stderr is a terminal and not --quiet.
   static bool shouldShow(bool quiet);
+  // Where the bar of this process goes, or nullptr for none: stderr when
+  // shouldShow, and never under mpirun (`distributed`). There a rank's
+  // stderr is a pipe to mpirun, which copies it to wherever its own stderr
+  // goes (a file, when redirected: issue 27 item 16 found \r and ESC[K
+  // there), and Open MPI 4.1 gives a rank's stdout a pty whatever mpirun's
+  // stdout is (measured: `mpirun -np 1 sh -c 'test -t 1' > file` is a
+  // terminal), so no rank can tell whether anyone sees a terminal.
+  static std::FILE* stream(bool quiet, bool distributed);
 
   bool enabled() const { return enabled_; }
 

@@ -101,8 +101,11 @@ void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& s
   unused(a.maxSpp && *a.maxSpp > o.spp, sc.maxSpp && *sc.maxSpp > o.spp, "--max-spp", "max_spp",
          "every pass takes --spp samples per pixel, up to --extra-cap x --spp where the pilot finds noisy eye paths "
          "(--extra-samples); more passes take more");
+  // Named by the method in use: -m time was told about "accumulation --progressive" (issue 27 item 16).
   unused(bool(a.frames), bool(sc.frames), "--frames", "frames",
-         "passes replace in-between frames: accumulation --progressive renders one stratified time per pass");
+         o.method == "accumulation"
+             ? "passes replace in-between frames: accumulation --progressive renders one stratified time per pass"
+             : "only the accumulation method renders in-between frames");
   unused(a.search && *a.search == "4d", sc.search && *sc.search == "4d", "--search 4d", "search",
          "the passes gather with fixed kernels, not a k-NN search");
   unused(a.kernelSpace && *a.kernelSpace != "uniform", sc.kernelSpace && *sc.kernelSpace != "uniform",

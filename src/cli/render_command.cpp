@@ -498,8 +498,8 @@ int runRender(const RenderArgs& a) {
                 " needs an animation, but " + a.scene + " has no \"animation\" block (docs/scene-format.md)");
 
   ThreadLimit limit(a.threads);
-  // Under mpirun rank 0 draws on its stdout pty, never on the stderr pipe
-  // (ProgressBar::stream).
+  // Under mpirun no bar (ProgressBar::stream): progressive renders print a
+  // line per pass instead.
   std::FILE* barStream = ProgressBar::stream(a.quiet, comm.distributed());
   ProgressBar bar(comm.root() && barStream, barStream ? barStream : stderr);
   if (comm.root())

@@ -524,17 +524,29 @@ void Importer::worldBegin(const Loc& at) {
     static const std::set<std::string> kSamplers = {"halton", "sobol", "zsobol", "paddedsobol", "pmj02bn", "independent",
                                                     "random", "02sequence", "lowdiscrepancy", "maxmindist", "stratified"};
     if (!kSamplers.count(sampler_.type)) failAt(sampler_.at, "Sampler \"" + sampler_.type + "\" is not supported");
-    int spp;
+    // In 64 bits: xsamples 65536 x ysamples 65536 wrapped to 0 in int and
+    // was called "at least 1, got 0" (issue 27 item 17).
+    int64_t spp;
+    std::string what;
     if (sampler_.type == "stratified") {
       if (!ps.has("xsamples") || !ps.has("ysamples"))
         failAt(sampler_.at, "Sampler \"stratified\": give xsamples and ysamples (pbrt-v3 and v4 defaults differ)");
-      spp = ps.getInt("xsamples", 2) * ps.getInt("ysamples", 2);
+      int64_t x = ps.getInt("xsamples", 2), y = ps.getInt("ysamples", 2);
+      if (x < 1 || y < 1)
+        failAt(sampler_.at, "Sampler \"stratified\": xsamples and ysamples must be at least 1, got " + std::to_string(x) +
+                                " and " + std::to_string(y));
+      spp = x * y;
+      what = "xsamples " + std::to_string(x) + " x ysamples " + std::to_string(y) + " = " + std::to_string(spp);
       ps.markUsed("jitter");
     } else {
       spp = ps.getInt("pixelsamples", 16);
+      what = "pixelsamples " + std::to_string(spp);
     }
-    if (spp < 1) failAt(sampler_.at, "Sampler: samples per pixel must be at least 1, got " + std::to_string(spp));
-    r.spp = spp;
+    if (spp < 1) failAt(sampler_.at, "Sampler: samples per pixel must be at least 1, got " + what);
+    if (spp > scene::limits::kSpp.hi)
+      failAt(sampler_.at, "Sampler \"" + sampler_.type + "\": " + what + " samples per pixel is more than tdpm's limit of " +
+                              std::to_string(scene::limits::kSpp.hi) + " (2^20, as --spp and render.spp)");
+    r.spp = int(spp);
     for (const char* q : {"seed", "randomization", "dimensions", "jitter"}) ps.markUsed(q);
     note(sampler_.at, "Sampler \"" + sampler_.type + "\": its pattern is replaced by tdpm's own sampler (same spp)");
     ps.checkAllUsed();
