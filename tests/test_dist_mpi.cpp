@@ -301,6 +301,14 @@ TEST_CASE("mpi: ranks with another scene or other options stop with one error na
   CHECK(usage.exitCode != 124);
   CHECK(occurrences(usage.output, "tdpm: rank 1: --photons: At Most 1 required but received 2") == 1);
   CHECK(occurrences(usage.output, "rank-exit 2") == 2);
+  // Another subcommand on one rank (render waited in a collective that
+  // compare's ranks never join).
+  CommandResult other = runMpmd(cube + " --seed 7", "compare '" + dir + "/a.exr' '" + dir + "/b.exr'");
+  INFO(other.output);
+  CHECK(other.exitCode != 124);
+  CHECK(occurrences(other.output, "tdpm: error: the ranks of this mpirun job run different subcommands: render on "
+                                  "rank 0, compare on rank 1") == 1);
+  CHECK(occurrences(other.output, "rank-exit 2") == 2);
   check(runMpmd(cube + " --seed 7",
                 "render '" + scenes + "cube-caustic.json' --resolution 20x12 --seed 7 -m standard" + common),
         "the options method (time on rank 0, standard on rank 1), resolution (16x12 on rank 0, 20x12 on rank 1)");

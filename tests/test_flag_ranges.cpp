@@ -125,3 +125,35 @@ TEST_CASE("flag ranges: kappa's end points for a 1 s shutter are named so that b
   CHECK(sceneError("kappa", "7.7e-34").find("needs kappa in [7.704e-34, 8.507e+37]") != std::string::npos);
   CHECK(sceneError("kappa", "8.51e37").find("needs kappa in [7.704e-34, 8.507e+37]") != std::string::npos);
 }
+
+TEST_CASE("flag ranges: every integer flag and its scene key accept both end points, refuse one past them") {
+  struct IntFlag {
+    const char* flag;
+    const char* key;
+    limits::IntRange range;
+  };
+  const IntFlag flags[] = {
+      {"--spp", "spp", limits::kSpp},
+      {"--max-spp", nullptr, limits::kSpp},
+      {"--max-depth", "max_depth", limits::kMaxDepth},
+      {"--photons", "photons", limits::kPhotons},
+      {"--global-photons", "global_photons", limits::kPhotons},
+      {"--frames", "frames", limits::kFrames},
+      {"--k", "k", limits::kK},
+      {"--gather", "gather", limits::kGather},
+      {"--passes", nullptr, limits::kPasses},
+      {"--extra-cap", nullptr, cli::kExtraCapRange},
+  };
+  for (const IntFlag& f : flags) {
+    INFO(f.flag << " [" << f.range.lo << ", " << f.range.hi << "]");
+    CHECK(parseError(f.flag, std::to_string(f.range.lo)) == "");
+    CHECK(parseError(f.flag, std::to_string(f.range.hi)) == "");
+    CHECK(parseError(f.flag, std::to_string(f.range.lo - 1)) != "");
+    CHECK(parseError(f.flag, std::to_string(f.range.hi + 1)) != "");
+    if (!f.key) continue;
+    CHECK(sceneError(f.key, std::to_string(f.range.lo)) == "");
+    CHECK(sceneError(f.key, std::to_string(f.range.hi)) == "");
+    CHECK(sceneError(f.key, std::to_string(f.range.lo - 1)) != "");
+    CHECK(sceneError(f.key, std::to_string(f.range.hi + 1)) != "");
+  }
+}

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <sstream>
@@ -51,6 +52,46 @@ int runReporting(F&& f, dist::Comm& comm, bool everyRank) {
   }
 }
 
+// Under mpirun the ranks may have been given other arguments (MPMD,
+// `mpirun -np 1 tdpm A : -np 1 tdpm B`): a rank that stopped at its usage
+// error alone, or ran another subcommand, left the others waiting for it
+// for ever (issue 27 item 1). The ranks agree first, in one fixed-size
+// allgather: when any of them stopped (`code` >= 0, with its help or error
+// text in `out` / `err`), rank 0 prints the lowest such rank's text (named
+// when it is not rank 0) and every rank returns that code; when their
+// subcommands differ, every rank returns 2. Otherwise -1: go on.
+int agreeOnArguments(dist::Comm& comm, int code, const std::string& out, const std::string& err, int subcommand) {
+  std::vector<uint64_t> all = comm.allgather((code < 0 ? 0 : uint64_t(code) + 1) | (uint64_t(subcommand) << 8));
+  int first = -1;
+  for (size_t r = 0; r < all.size() && first < 0; ++r)
+    if (all[r] & 0xff) first = int(r);
+  if (first >= 0) {
+    std::string text = comm.rank() == first ? out + '\0' + err : std::string();
+    uint64_t n = text.size();
+    comm.broadcast(&n, sizeof n, first);
+    text.resize(size_t(n));
+    if (n > 0) comm.broadcast(&text[0], n, first);
+    if (comm.root()) {
+      size_t cut = text.find('\0');
+      std::string o = text.substr(0, cut), e = cut == std::string::npos ? std::string() : text.substr(cut + 1);
+      std::string who = first != 0 ? "tdpm: rank " + std::to_string(first) + ": " : std::string();
+      if (!o.empty()) std::fprintf(stdout, "%s%s", who.c_str(), o.c_str());
+      if (!e.empty()) std::fprintf(stderr, "%s%s", who.c_str(), e.c_str());
+      std::fflush(stdout);
+    }
+    return int((all[size_t(first)] & 0xff) - 1);
+  }
+  for (size_t r = 1; r < all.size(); ++r) {
+    if (all[r] == all[0]) continue;
+    static const char* const kNames[] = {"none", "render", "compare", "convert"};
+    if (comm.root())
+      std::fprintf(stderr, "tdpm: error: the ranks of this mpirun job run different subcommands: %s on rank 0, %s on rank %zu\n",
+                   kNames[std::min<uint64_t>(3, all[0] >> 8)], kNames[std::min<uint64_t>(3, all[r] >> 8)], r);
+    return 2;
+  }
+  return -1;
+}
+
 }  // namespace
 
 int run(int argc, char** argv) {
@@ -77,31 +118,9 @@ int run(int argc, char** argv) {
     code = app.exit(e, out, err) == 0 ? 0 : 2;
   }
   if (comm.distributed()) {
-    // Under mpirun the ranks may have been given other arguments (MPMD,
-    // `mpirun -np 1 tdpm A : -np 1 tdpm B`): a rank that stopped here alone
-    // left the others waiting for it for ever (issue 27 item 1). The ranks
-    // agree first: when any of them stopped, rank 0 prints the lowest such
-    // rank's output (named when it is not rank 0) and every rank returns its code.
-    std::vector<uint64_t> stopped = comm.allgather(code < 0 ? 0 : uint64_t(code) + 1);
-    int first = -1;
-    for (size_t r = 0; r < stopped.size() && first < 0; ++r)
-      if (stopped[r]) first = int(r);
-    if (first >= 0) {
-      std::string text = comm.rank() == first ? out.str() + '\0' + err.str() : std::string();
-      uint64_t n = text.size();
-      comm.broadcast(&n, sizeof n, first);
-      text.resize(size_t(n));
-      if (n > 0) comm.broadcast(&text[0], n, first);
-      if (comm.root()) {
-        size_t cut = text.find('\0');
-        std::string o = text.substr(0, cut), e = cut == std::string::npos ? std::string() : text.substr(cut + 1);
-        std::string who = first != 0 ? "tdpm: rank " + std::to_string(first) + ": " : std::string();
-        if (!o.empty()) std::fprintf(stdout, "%s%s", who.c_str(), o.c_str());
-        if (!e.empty()) std::fprintf(stderr, "%s%s", who.c_str(), e.c_str());
-        std::fflush(stdout);
-      }
-      return int(stopped[size_t(first)] - 1);
-    }
+    int agreed = agreeOnArguments(comm, code, out.str(), err.str(),
+                                  render->parsed() ? 1 : compare->parsed() ? 2 : convert->parsed() ? 3 : 0);
+    if (agreed >= 0) return agreed;
   } else if (code >= 0) {
     std::fputs(out.str().c_str(), stdout);
     std::fputs(err.str().c_str(), stderr);
