@@ -3,6 +3,7 @@
 // ranges, against each other and against the layers.
 #include "render/progressive_check.h"
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
@@ -68,7 +69,7 @@ double checkPaths(const Checker& c, const char* name, double wanted, const char*
   double v = c.inRange(name, 0, wanted > 0 ? cap : 0, false,
                        wanted > 0 ? "outside [0, " + g(cap) + "]: " + flag + " " + g(wanted) +
                                         " emits at most that many paths per pass"
-                                  : std::string("but this render traces no such photons (") + flag + " 0), so it must be 0");
+                                  : std::string("but this render traces no such photons (") + flag + "), so it must be 0");
   if (std::fmod(v, double(photon::kPathsPerBatch)) != 0)
     throw c.bad(std::string("tdpm/progressive/scalar/") + name + " is " + g(v) + ", not a whole number of " +
                 std::to_string(photon::kPathsPerBatch) + "-path batches");
@@ -133,9 +134,12 @@ void checkProgressiveState(const ProgressiveState& s, const RenderOptions& opt, 
 
   const double passes = double(s.passesDone);
   const bool wantGlobal = opt.visualizeGlobal || opt.gatherRays > 0;
-  const double cp = checkPaths(c, kCausticPaths, double(opt.causticPhotons), opt.causticPhotonsSource.c_str());
+  const double cp = checkPaths(c, kCausticPaths, double(opt.causticPhotons),
+                               opt.causticPhotons > 0 ? opt.causticPhotonsSource.c_str() : "its caustic photons are 0");
   const double gp = checkPaths(c, kGlobalPaths, wantGlobal ? double(opt.globalPhotons) : 0.0,
-                               wantGlobal ? opt.globalPhotonsSource.c_str() : "--gather");
+                               !wantGlobal ? "--gather 0 without --global-direct"
+                               : opt.globalPhotons > 0 ? opt.globalPhotonsSource.c_str()
+                                                       : "its global photons are 0");
   // Pass i traces paths [i p, (i + 1) p) (photon/tracer.h firstPath, 64 bits);
   // the passes this run may add must keep that in range.
   const double lastPass = std::max(passes + 1, double(opt.passes));
