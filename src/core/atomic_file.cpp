@@ -13,6 +13,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <map>
+#include <mutex>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -74,6 +76,38 @@ bool digitsValue(const std::string& s, size_t b, size_t e, long long& v) {
   return true;
 }
 
+// A temporary name's process id, whatever target it belongs to.
+struct Leftover {
+  std::string entry;
+  long long pid, n;
+};
+
+// The leftovers in `dir` whose process was gone when the directory was read.
+std::vector<Leftover> scanLeftovers(const std::string& dir) {
+  std::vector<Leftover> out;
+  DIR* d = ::opendir(dir.empty() ? "." : dir.c_str());
+  if (!d) return out;
+  const long long self = ::getpid();
+  while (const struct dirent* e = ::readdir(d)) {
+    const std::string entry = e->d_name;
+    if (entry.size() < 8 || entry[0] != '.') continue;
+    const size_t dot = entry.find_last_of('.');
+    if (dot == std::string::npos || dot < 5) continue;
+    const size_t tmp = entry.rfind(".tmp.", dot - 1);
+    long long pid = 0, n = 0;
+    if (tmp == std::string::npos || tmp + 5 > dot) continue;
+    if (!digitsValue(entry, tmp + 5, dot, pid) || !digitsValue(entry, dot + 1, entry.size(), n)) continue;
+    if (pid <= 0 || pid == self || pid > INT_MAX) continue;
+    if (::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge (EPERM)
+    out.push_back({entry, pid, n});
+  }
+  ::closedir(d);
+  return out;
+}
+
+std::mutex gLeftoverMutex;
+std::map<std::string, std::vector<Leftover>> gLeftovers;  // directory -> leftovers not yet removed
+
 // Removes the temporaries of `name` in `dir` that a killed run left (issue
 // 27 item 13: SIGKILL leaves them, 32 MB each, and nothing else removes
 // them). Only files named exactly as tempName names them for this target
@@ -83,27 +117,24 @@ bool digitsValue(const std::string& s, size_t b, size_t e, long long& v) {
 // two hosts writing one network directory could see each other's live
 // temporaries as dead (docs/output-safety.md).
 void removeStaleTemporaries(const std::string& dir, const std::string& name, size_t limit) {
-  DIR* d = ::opendir(dir.empty() ? "." : dir.c_str());
-  if (!d) return;
-  const long long self = ::getpid();
-  std::vector<std::string> stale;
-  while (const struct dirent* e = ::readdir(d)) {
-    const std::string entry = e->d_name;
-    if (entry.size() < 8 || entry[0] != '.') continue;
-    const size_t dot = entry.find_last_of('.');
-    const size_t tmp = entry.rfind(".tmp.", dot == std::string::npos || dot == 0 ? 0 : dot - 1);
-    long long pid = 0, n = 0;
-    if (dot == std::string::npos || tmp == std::string::npos || tmp + 5 > dot) continue;
-    if (!digitsValue(entry, tmp + 5, dot, pid) || !digitsValue(entry, dot + 1, entry.size(), n)) continue;
-    if (pid <= 0 || pid == self || pid > INT_MAX) continue;
-    if (dir + entry != tempName(dir, name, limit, (unsigned long long)n, pid)) continue;
-    if (::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge (EPERM)
-    stale.push_back(dir + entry);
-  }
-  ::closedir(d);
-  for (const std::string& path : stale) {
+  // Each directory is read once per process: an animation writes thousands
+  // of frames into one directory, and reading it for every file would cost
+  // frames^2 directory entries.
+  std::lock_guard<std::mutex> lock(gLeftoverMutex);
+  auto it = gLeftovers.find(dir);
+  if (it == gLeftovers.end()) it = gLeftovers.emplace(dir, scanLeftovers(dir)).first;
+  std::vector<Leftover>& list = it->second;
+  for (size_t i = 0; i < list.size();) {
+    const Leftover& l = list[i];
+    const std::string path = dir + l.entry;
+    if (path != tempName(dir, name, limit, (unsigned long long)l.n, l.pid)) {  // another target's, or not exactly ours
+      ++i;
+      continue;
+    }
     struct stat st;
-    if (::lstat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode)) ::unlink(path.c_str());
+    if (::kill(pid_t(l.pid), 0) != 0 && errno == ESRCH && ::lstat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode))
+      ::unlink(path.c_str());
+    list.erase(list.begin() + long(i));
   }
 }
 
