@@ -222,3 +222,23 @@ TEST_CASE("resume: N passes, then N more resumed from the EXR, equal 2N passes i
   CHECK(off.output.find("extra_samples: 0.5 (cap 32) in") != std::string::npos);
   std::system(("rm -rf '" + dir + "'").c_str());
 }
+
+TEST_CASE("resume: a long state's spp layer is checked against the float sums the pass loop forms") {
+  // 2^20 passes of 17 samples: 17.8M per pixel, beyond 2^24, where the
+  // float layer rounds as it grows. A legitimate state holds the loop's own
+  // float sum, not passes x spp; an edited pass count is still refused.
+  Setup s;
+  s.options.spp = 17;
+  ProgressiveState st = s.stateFor(s.scene, s.options);
+  const int passes = 1 << 20;
+  Setup::fill(st, s.options, 48, passes);
+  float sum = 0;
+  for (int i = 0; i < passes; ++i) sum += 17.0f;
+  st.layers["spp"] = std::vector<float>(48, sum);
+  std::string path = s.write("long.exr", &st, 8, 6);
+  CHECK(s.errorOf(path).empty());
+  st.passesDone = passes / 2;
+  st.scalars["photons.emitted"] = double(passes / 2) * 12 * 1024;
+  path = s.write("halved.exr", &st, 8, 6);
+  CHECK(s.errorOf(path).find("damaged progressive state: " + path + ": layer progressive.spp is ") == 0);
+}
