@@ -398,11 +398,13 @@ std::string addPass(const Scene& scene, const RenderOptions& opt, ProgressiveSta
     for (int c = 0; c < 3; ++c) {
       const double m = double(mean[3 * i + size_t(c)]);
       const double a = double(sum[c][i]) + m, b = double(sq[c][i]) + m * m;
-      sum[c][i] = float(a);
-      sq[c][i] = float(b);
-      if (overflow.empty() && !(std::fabs(a) <= double(FLT_MAX) && b <= double(FLT_MAX))) {
+      const bool sumFits = std::fabs(a) <= double(FLT_MAX);
+      if (sumFits && b <= double(FLT_MAX)) {
+        sum[c][i] = float(a);
+        sq[c][i] = float(b);
+      } else if (overflow.empty()) {  // the layers keep their old values: the render is refused
         const char* names[2][3] = {{"sum.R", "sum.G", "sum.B"}, {"sumsq.R", "sumsq.G", "sumsq.B"}};
-        const bool inSum = !(std::fabs(a) <= double(FLT_MAX));
+        const bool inSum = !sumFits;
         char buf[400];
         std::snprintf(buf, sizeof buf,
                       "progressive pass %d: pixel (%zu, %zu) has the pass value %.3g, and its %s (%.3g) is beyond the "
