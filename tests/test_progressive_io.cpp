@@ -170,7 +170,8 @@ TEST_CASE("progressive io: no state, and damaged states") {
       msg = e.what();
     }
     CAPTURE(msg);
-    CHECK(msg.rfind("old.exr: ", 0) == 0);
+    // Another layout version is "old.exr: ..."; a damaged state says so first.
+    CHECK((msg.rfind("old.exr: ", 0) == 0 || msg.rfind("damaged progressive state: old.exr: ", 0) == 0));
     CHECK(msg.find(words) != std::string::npos);
   };
   expectError([](image::ExrFile& e) { e.metadata["tdpm/progressive/version"] = "2"; }, "layout version '2'");

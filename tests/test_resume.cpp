@@ -39,11 +39,27 @@ struct Setup {
     ProgressiveState st;
     st.fingerprint = f.value;
     st.settings = f.settings;
-    st.passesDone = 4;
-    st.scalars["photons.emitted"] = 4.0e6 / 3.0;
-    const size_t n = size_t(s.camera.width) * size_t(s.camera.height);
-    for (const char* name : {"sum.R", "sum.G", "sum.B", "spp"}) st.layers[name] = std::vector<float>(n, 0.25f);
+    fill(st, o, size_t(s.camera.width) * size_t(s.camera.height), 4);
     return st;
+  }
+  // Every scalar and layer of `passes` passes, consistent with each other
+  // and with `o` (what render/progressive_check.h accepts).
+  static void fill(ProgressiveState& st, const RenderOptions& o, size_t n, int passes) {
+    st.passesDone = passes;
+    const double p = passes;
+    st.scalars["photons.caustic_paths_per_pass"] = 10 * 1024;
+    st.scalars["photons.global_paths_per_pass"] = 2 * 1024;
+    st.scalars["photons.emitted"] = p * 12 * 1024;
+    st.scalars["photons.stored"] = p * 3000;
+    st.scalars["seconds"] = 1.5;
+    for (const char* k : {"kernel.caustic.radius_1", "kernel.caustic.half_window_1", "kernel.caustic.spatial_radius_1",
+                          "kernel.global.radius_1", "kernel.global.half_window_1", "kernel.global.spatial_radius_1"})
+      st.scalars[k] = 0.125;
+    for (const char* k : {"kernel.radius", "kernel.spatial_radius", "kernel.half_window"}) st.scalars[k] = 0.0625;
+    for (const char* name : {"sum.R", "sum.G", "sum.B"}) st.layers[name] = std::vector<float>(n, 0.25f * float(p));
+    for (const char* name : {"sumsq.R", "sumsq.G", "sumsq.B"})
+      st.layers[name] = std::vector<float>(n, 0.0625f * float(p));
+    st.layers["spp"] = std::vector<float>(n, float(p * o.spp));
   }
 
   std::string write(const std::string& name, const ProgressiveState* st, int w, int h) const {
@@ -101,7 +117,7 @@ TEST_CASE("resume: files that are not a progressive render's") {
   const std::string damaged = s.dir + "/damaged.exr";
   image::writeExr(damaged, exr);
   std::string msg = s.errorOf(damaged);
-  CHECK(msg.rfind("--resume " + damaged + ": damaged progressive state: tdpm/progressive/passes is 'four'", 0) == 0);
+  CHECK(msg.rfind("damaged progressive state: " + damaged + ": tdpm/progressive/passes is 'four'", 0) == 0);
 }
 
 TEST_CASE("resume: another resolution") {
@@ -165,8 +181,7 @@ TEST_CASE("resume: a fresh progressive render starts at pass 0 with its fingerpr
   CHECK(fresh.settings.at("photons") == "200000");
   CHECK(fresh.layers.empty());
   // Written after some passes, it is what a resumed run of the same render accepts.
-  fresh.passesDone = 2;
-  fresh.layers["sum.R"] = std::vector<float>(48, 1.0f);
+  Setup::fill(fresh, s.options, 48, 2);
   const std::string path = s.write("run1.exr", &fresh, 8, 6);
   const std::string resume = path;
   ProgressiveState next = cli::initialProgressiveState(&resume, s.scene, s.options);
@@ -206,4 +221,24 @@ TEST_CASE("resume: N passes, then N more resumed from the EXR, equal 2N passes i
   CHECK(off.exitCode == 1);
   CHECK(off.output.find("extra_samples: 0.5 (cap 32) in") != std::string::npos);
   std::system(("rm -rf '" + dir + "'").c_str());
+}
+
+TEST_CASE("resume: a long state's spp layer is checked against the float sums the pass loop forms") {
+  // 2^20 passes of 17 samples: 17.8M per pixel, beyond 2^24, where the
+  // float layer rounds as it grows. A legitimate state holds the loop's own
+  // float sum, not passes x spp; an edited pass count is still refused.
+  Setup s;
+  s.options.spp = 17;
+  ProgressiveState st = s.stateFor(s.scene, s.options);
+  const int passes = 1 << 20;
+  Setup::fill(st, s.options, 48, passes);
+  float sum = 0;
+  for (int i = 0; i < passes; ++i) sum += 17.0f;
+  st.layers["spp"] = std::vector<float>(48, sum);
+  std::string path = s.write("long.exr", &st, 8, 6);
+  CHECK(s.errorOf(path).empty());
+  st.passesDone = passes / 2;
+  st.scalars["photons.emitted"] = double(passes / 2) * 12 * 1024;
+  path = s.write("halved.exr", &st, 8, 6);
+  CHECK(s.errorOf(path).find("damaged progressive state: " + path + ": layer progressive.spp is ") == 0);
 }

@@ -22,6 +22,7 @@
 #include "cli/progress_bar.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/signals.h"
 #include "core/memory.h"
 #include "core/timer.h"
 #include "image/png.h"
@@ -51,6 +52,7 @@ int runProcess(const std::vector<std::string>& argv, const std::string& log) {
   std::vector<char*> args;
   for (const std::string& s : argv) args.push_back(const_cast<char*>(s.c_str()));
   args.push_back(nullptr);
+  if (signals::pendingSignal()) return -1;  // tdpm is ending: no ffmpeg to start
   pid_t pid = fork();
   if (pid < 0) return -1;
   if (pid == 0) {
@@ -64,6 +66,7 @@ int runProcess(const std::vector<std::string>& argv, const std::string& log) {
     execv(args[0], args.data());
     _exit(127);
   }
+  signals::ChildGuard child(pid);  // a signal kills ffmpeg, and waitpid returns
   int status = 0;
   while (waitpid(pid, &status, 0) < 0)
     if (errno != EINTR) return -1;
@@ -84,6 +87,11 @@ std::string readTail(const std::string& path, size_t max) {
 // renamed into place (a failure leaves any old video as it was).
 void assembleVideo(const std::string& ffmpeg, const std::string& video, const std::vector<std::string>& previews,
                    double fps) {
+  // SIGINT/SIGTERM/SIGHUP while the video is made: ffmpeg is killed at once
+  // (signals::ChildGuard), the folder is removed by `cleanup` below, and
+  // only then, when this deferral ends, does the signal end tdpm (it used
+  // to leave the folder and a running ffmpeg; issue 27 item 13).
+  signals::Deferral untilCleanedUp;
   std::string tmpl = directoryOf(video) + "/.tdpm-video-XXXXXX";
   std::vector<char> buf(tmpl.begin(), tmpl.end());
   buf.push_back('\0');
@@ -117,6 +125,7 @@ void assembleVideo(const std::string& ffmpeg, const std::string& video, const st
   argv.push_back(out);
   std::string log = tmp + "/ffmpeg.log";
   int code = runProcess(argv, log);
+  if (signals::pendingSignal()) throw Error("--video: interrupted");  // not shown: the signal ends tdpm first
   if (code != 0)
     throw Error("--video: ffmpeg failed (exit status " + std::to_string(code) + ") making '" + video +
                 "': " + readTail(log, 600));

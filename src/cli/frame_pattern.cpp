@@ -1,8 +1,8 @@
 // cli/frame_pattern.cpp — frame-numbered output names and frame ranges.
 #include "cli/frame_pattern.h"
 
+#include <climits>
 #include <cctype>
-#include <cstdio>
 
 #include "core/error.h"
 
@@ -11,6 +11,10 @@ namespace tdpm::cli {
 bool hasFramePlaceholder(const std::string& pattern) { return pattern.find('#') != std::string::npos; }
 
 std::string formatFramePath(const std::string& pattern, int frame) {
+  // Built as a string: any run length gives its zero-padded number (a
+  // 32-byte snprintf buffer cut runs of 32 or more, and every frame went
+  // to one file; issue 27 item 8). checkFramePattern bounds the length.
+  const std::string digits = std::to_string(frame);
   std::string out;
   for (size_t i = 0; i < pattern.size();) {
     if (pattern[i] != '#') {
@@ -19,9 +23,8 @@ std::string formatFramePath(const std::string& pattern, int frame) {
     }
     size_t run = 0;
     while (i + run < pattern.size() && pattern[i + run] == '#') ++run;
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%0*d", int(run), frame);
-    out += buf;
+    if (run > digits.size()) out.append(run - digits.size(), '0');
+    out += digits;
     i += run;
   }
   return out;
@@ -64,6 +67,13 @@ void checkFramePattern(const std::string& pattern, const FrameRange& range, cons
   size_t slash = pattern.find_last_of('/');
   std::string name = slash == std::string::npos ? pattern : pattern.substr(slash + 1);
   if (name == ".exr") throw Error(flag + ": '" + pattern + "' has no file name before .exr");
+  // The longest name it gives (the last frame's, or a run's own width) must
+  // be a file name: its PNG preview has the same length.
+  const std::string longest = formatFramePath(name, range.last);
+  if (longest.size() > size_t(NAME_MAX))
+    throw Error(flag + ": '" + pattern + "' gives file names of " + std::to_string(longest.size()) +
+                " bytes (frame " + std::to_string(range.last) + "), more than a file name may have (" +
+                std::to_string(NAME_MAX) + "); use fewer #");
 }
 
 }  // namespace tdpm::cli

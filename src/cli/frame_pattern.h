@@ -11,7 +11,7 @@ namespace tdpm::cli {
 bool hasFramePlaceholder(const std::string& pattern);
 
 // `pattern` with every run of '#' replaced by `frame`, zero-padded to the
-// run's length (a longer number keeps all its digits).
+// run's length, of any length (a longer number keeps all its digits).
 std::string formatFramePath(const std::string& pattern, int frame);
 
 struct FrameRange {
@@ -24,7 +24,9 @@ struct FrameRange {
 FrameRange parseFrameRange(const std::string& text, int frames, const std::string& flag = "--frame-range");
 
 // Throws unless one output per frame is possible: a pattern without # for
-// more than one frame is an error; the name must end in .exr.
+// more than one frame is an error; the name must end in .exr; the file
+// name it gives for range.last must fit NAME_MAX (255 bytes), or the
+// error names the pattern.
 void checkFramePattern(const std::string& pattern, const FrameRange& range, const std::string& flag = "--output");
 
 }  // namespace tdpm::cli

@@ -4,6 +4,7 @@
 #include "core/error.h"
 #include "image/exr.h"
 #include "render/fingerprint.h"
+#include "render/progressive_check.h"
 #include "render/progressive_io.h"
 
 namespace tdpm::cli {
@@ -22,6 +23,8 @@ ProgressiveState loadResumeState(const std::string& path, const scene::SceneDesc
   try {
     exr = image::readExr(path);  // "<path>: No such file or directory", "...: not an OpenEXR file", ...
     state = progressiveStateOf(exr, path);
+  } catch (const DamagedStateError&) {
+    throw;  // "damaged progressive state: <path>: ..."
   } catch (const Error& e) {
     throw Error("--resume " + std::string(e.what()));
   }
@@ -45,6 +48,8 @@ ProgressiveState loadResumeState(const std::string& path, const scene::SceneDesc
     for (const std::string& d : diff) list += (list.empty() ? "" : "; ") + d;
     throw Error(flag + ": it is another render, so it cannot be continued: " + list);
   }
+  // The same render: now every value must be one it could have written.
+  checkProgressiveState(*state, options, w, h, path);
   return std::move(*state);
 }
 

@@ -2,13 +2,19 @@
 // rename-on-commit (single and grouped, with rollback), cleanup.
 #include "core/atomic_file.h"
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>  // kill(pid, 0)
 #include <limits.h>
 #include <stdio.h>  // renameat2, RENAME_EXCHANGE (glibc >= 2.28)
+#include <sys/file.h>  // flock
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <map>
+#include <mutex>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -47,14 +53,89 @@ size_t nameMax(const std::string& dir) {
 
 // ".<name>.tmp.<pid>.<n>" in `dir`, with <name> cut (at a UTF-8 character
 // boundary) so the whole name fits in `limit` bytes.
-std::string tempName(const std::string& dir, const std::string& name, size_t limit, unsigned n) {
-  const std::string suffix = ".tmp." + std::to_string(::getpid()) + "." + std::to_string(n);
+std::string tempName(const std::string& dir, const std::string& name, size_t limit, unsigned long long n,
+                     long long pid = ::getpid()) {
+  const std::string suffix = ".tmp." + std::to_string(pid) + "." + std::to_string(n);
   size_t keep = name.size();
   if (1 + keep + suffix.size() > limit) {
     keep = limit > 1 + suffix.size() ? limit - 1 - suffix.size() : 0;
     while (keep > 0 && (static_cast<unsigned char>(name[keep]) & 0xC0) == 0x80) --keep;
   }
   return dir + "." + name.substr(0, keep) + suffix;
+}
+
+// A run of ASCII digits, the whole of [b, e), as a number (false: not one,
+// or more than 18 digits).
+bool digitsValue(const std::string& s, size_t b, size_t e, long long& v) {
+  if (b >= e || e - b > 18) return false;
+  v = 0;
+  for (size_t i = b; i < e; ++i) {
+    if (s[i] < '0' || s[i] > '9') return false;
+    v = v * 10 + (s[i] - '0');
+  }
+  return true;
+}
+
+// A temporary name's process id, whatever target it belongs to.
+struct Leftover {
+  std::string entry;
+  long long pid, n;
+};
+
+// The leftovers in `dir` whose process was gone when the directory was read.
+std::vector<Leftover> scanLeftovers(const std::string& dir) {
+  std::vector<Leftover> out;
+  DIR* d = ::opendir(dir.empty() ? "." : dir.c_str());
+  if (!d) return out;
+  const long long self = ::getpid();
+  while (const struct dirent* e = ::readdir(d)) {
+    const std::string entry = e->d_name;
+    if (entry.size() < 8 || entry[0] != '.') continue;
+    const size_t dot = entry.find_last_of('.');
+    if (dot == std::string::npos || dot < 5) continue;
+    const size_t tmp = entry.rfind(".tmp.", dot - 1);
+    long long pid = 0, n = 0;
+    if (tmp == std::string::npos || tmp + 5 > dot) continue;
+    if (!digitsValue(entry, tmp + 5, dot, pid) || !digitsValue(entry, dot + 1, entry.size(), n)) continue;
+    if (pid <= 0 || pid == self || pid > INT_MAX) continue;
+    if (::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge (EPERM)
+    out.push_back({entry, pid, n});
+  }
+  ::closedir(d);
+  return out;
+}
+
+std::mutex gLeftoverMutex;
+std::map<std::string, std::vector<Leftover>> gLeftovers;  // directory -> leftovers not yet removed
+
+// Removes the temporaries of `name` in `dir` that a killed run left (issue
+// 27 item 13: SIGKILL leaves them, 32 MB each, and nothing else removes
+// them). Only files named exactly as tempName names them for this target
+// (".<name>.tmp.<pid>.<n>", <name> cut as it would be), whose process is
+// gone (kill(pid, 0) fails with ESRCH): a live run's temporary, another
+// target's, or any other file is never touched. PIDs are this machine's:
+// two hosts writing one network directory could see each other's live
+// temporaries as dead (docs/output-safety.md).
+void removeStaleTemporaries(const std::string& dir, const std::string& name, size_t limit) {
+  // Each directory is read once per process: an animation writes thousands
+  // of frames into one directory, and reading it for every file would cost
+  // frames^2 directory entries.
+  std::lock_guard<std::mutex> lock(gLeftoverMutex);
+  auto it = gLeftovers.find(dir);
+  if (it == gLeftovers.end()) it = gLeftovers.emplace(dir, scanLeftovers(dir)).first;
+  std::vector<Leftover>& list = it->second;
+  for (size_t i = 0; i < list.size();) {
+    const Leftover& l = list[i];
+    const std::string path = dir + l.entry;
+    if (path != tempName(dir, name, limit, (unsigned long long)l.n, l.pid)) {  // another target's, or not exactly ours
+      ++i;
+      continue;
+    }
+    struct stat st;
+    if (::kill(pid_t(l.pid), 0) != 0 && errno == ESRCH && ::lstat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode))
+      ::unlink(path.c_str());
+    list.erase(list.begin() + long(i));
+  }
 }
 
 // Follows `target` if it is a symbolic link; fills `st` and returns true if
@@ -110,6 +191,7 @@ AtomicFile::AtomicFile(std::string target) : target_(std::move(target)) {
   resolveTarget(target_, final_, st);
   splitPath(final_, dir, name);
   const size_t limit = checkLength();
+  removeStaleTemporaries(dir, name, limit);
 
   // O_EXCL makes the name ours even if a stale temp of a crashed run with the
   // same pid exists; then we just take the next counter value. Mode 0666
@@ -168,6 +250,56 @@ void AtomicFile::sync() const {
 
 void AtomicFile::commit() { commitTogether({this}); }
 
+namespace {
+
+// flock(2) on the directories of a group's targets, held while the group is
+// renamed: two runs committing the same pair (six `--resume a.exr -o s.exr`
+// at once) would otherwise interleave their renames and leave one run's EXR
+// beside another's PNG (issue 27 item 12). The directory is locked, not a
+// lock file beside the outputs: nothing is left behind, and the kernel
+// drops the lock when the process dies, even by SIGKILL. Directories are
+// locked in (device, inode) order, so two groups never wait on each other.
+// Best effort: a file system without flock (ENOLCK, some network file
+// systems) is committed unlocked, as before.
+class DirectoryLocks {
+ public:
+  explicit DirectoryLocks(const std::vector<std::string>& finals) {
+    std::vector<std::pair<std::pair<dev_t, ino_t>, std::string>> dirs;
+    for (const std::string& f : finals) {
+      std::string dir, name;
+      splitPath(f, dir, name);
+      if (dir.empty()) dir = ".";
+      struct stat st;
+      if (::stat(dir.c_str(), &st) != 0) continue;
+      dirs.push_back({{st.st_dev, st.st_ino}, dir});
+    }
+    std::sort(dirs.begin(), dirs.end());
+    for (size_t i = 0; i < dirs.size(); ++i) {
+      if (i > 0 && dirs[i].first == dirs[i - 1].first) continue;
+      int fd = ::open(dirs[i].second.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+      if (fd < 0) continue;
+      int rc;
+      while ((rc = ::flock(fd, LOCK_EX)) != 0 && errno == EINTR) {
+      }
+      if (rc != 0) {
+        ::close(fd);
+        continue;
+      }
+      fds_.push_back(fd);
+    }
+  }
+  ~DirectoryLocks() {
+    for (size_t i = fds_.size(); i-- > 0;) ::close(fds_[i]);  // closing releases the lock
+  }
+  DirectoryLocks(const DirectoryLocks&) = delete;
+  DirectoryLocks& operator=(const DirectoryLocks&) = delete;
+
+ private:
+  std::vector<int> fds_;
+};
+
+}  // namespace
+
 void commitTogether(std::initializer_list<AtomicFile*> list) {
   const std::vector<AtomicFile*> files(list);
   for (const AtomicFile* f : files) TDPM_ASSERT(!f->committed_, "AtomicFile committed twice");
@@ -182,6 +314,12 @@ void commitTogether(std::initializer_list<AtomicFile*> list) {
     std::string backup;
   };
   std::vector<Done> done;
+  // A group (an EXR and its PNG) is renamed under the lock; taken before
+  // the deferral, so a signal while waiting for it acts at once.
+  std::vector<std::string> finals;
+  if (files.size() > 1)
+    for (const AtomicFile* f : files) finals.push_back(f->final_);
+  DirectoryLocks locked(finals);
   signals::Deferral noSignalsUntilDone;
 
   auto rollback = [&] {

@@ -8,7 +8,11 @@
 // PNG preview. We write to a unique temporary file in the *same directory*
 // (so rename(2) is atomic: same file system) and rename it over the target
 // only once the writer has finished. Temporaries are registered with
-// core/signals, so SIGINT/SIGTERM removes them.
+// core/signals, so SIGINT/SIGTERM removes them; those a SIGKILL left are
+// removed by the next AtomicFile of the same target (only exact
+// ".<name>.tmp.<pid>.<n>" files of processes that no longer run). A group
+// (commitTogether) is renamed under flock(2) on its directory, so runs
+// that write the same pair at once never leave a mixed pair.
 //
 // Where the bytes go: an existing target that is a symbolic link is written
 // *through* (the file it points to is replaced and the link stays, as cp and
@@ -24,7 +28,8 @@ namespace tdpm {
 
 class AtomicFile {
  public:
-  // Creates an empty temporary file ".<name>.tmp.<pid>.<counter>" beside the
+  // Removes stale temporaries of the target (see above), then
+  // creates an empty temporary file ".<name>.tmp.<pid>.<counter>" beside the
   // final target (<name> shortened so the temporary's name stays within the
   // file system's NAME_MAX). Throws tdpm::Error "<target>: <reason>" when the
   // target cannot be replaced (see the header comment), its name is too long,
@@ -64,7 +69,10 @@ class AtomicFile {
 // each is renamed over its target. If anything fails, the targets renamed
 // so far get their old contents back (or vanish if they did not exist), so
 // every target is as it was; then tdpm::Error is thrown. SIGINT/SIGTERM
-// waits until the renames are done (core/signals Deferral).
+// waits until the renames are done (core/signals Deferral). With more than
+// one file, the renames run under an exclusive flock on each target's
+// directory (best effort: unlocked where flock fails); a reader may take
+// it shared to read a consistent pair (docs/output-safety.md).
 void commitTogether(std::initializer_list<AtomicFile*> files);
 
 // Checks, before any work, that `target` can be written: everything the

@@ -25,6 +25,7 @@ std::atomic<int> gDeferrals{0};    // live Deferral objects
 std::atomic<int> gPending{0};      // signo postponed by a Deferral
 std::atomic<bool> gInstalled{false};
 std::atomic<bool> gSayStopping{true};  // the stop mode's "stopping" line
+std::atomic<int> gChild{0};        // ChildGuard's process, 0 if none
 
 static_assert(std::atomic<int>::is_always_lock_free, "signal handler needs lock-free atomics");
 
@@ -67,6 +68,8 @@ void handler(int signo) {
     if (gSayStopping.load()) writeStderr("\ntdpm: stopping (send the signal again to abort at once)\n");
     return;
   }
+  // This signal ends tdpm (now or when the deferral ends): the child first.
+  if (int child = gChild.load(); child > 0) ::kill(child, SIGKILL);
   if (gDeferrals.load() > 0) {
     gPending.store(signo);
     return;
@@ -126,6 +129,16 @@ void removeTemporary(const char* path) {
     }
   }
 }
+
+int pendingSignal() { return gPending.load(); }
+
+ChildGuard::ChildGuard(int pid) {
+  gChild.store(pid);
+  // A signal that came before the store did not see the child.
+  if (gPending.load() != 0) ::kill(pid, SIGKILL);
+}
+
+ChildGuard::~ChildGuard() { gChild.store(0); }
 
 Deferral::Deferral() { gDeferrals.fetch_add(1); }
 

@@ -1,7 +1,8 @@
 // core/signals.h — what SIGINT, SIGTERM, SIGHUP and SIGUSR1 do to a tdpm run.
 // Owns: the signal handlers, the registry of temporary files a signal must
 // remove, the "stop requested" flag, and deferral around short critical
-// sections (renaming a finished output pair into place).
+// sections (renaming a finished output pair into place), and the child
+// process (ffmpeg) a signal must end with tdpm.
 // Why here: every output goes through core/atomic_file, which registers its
 // temporary; a progressive renderer will switch to StopMode and poll
 // stopRequested(). Everything the handler touches is async-signal-safe
@@ -44,6 +45,25 @@ constexpr int kSlots = 32;
 constexpr int kMaxPath = 4096;
 bool addTemporary(const char* path);
 void removeTemporary(const char* path);
+
+// The signal postponed by a Deferral (0: none): work that would be thrown
+// away when the deferral ends (starting ffmpeg, renaming its video) can
+// skip itself.
+int pendingSignal();
+
+// While an object lives, `pid` is a child process that must not outlive
+// tdpm: a signal that ends tdpm (or is postponed by a Deferral to do so)
+// first kills it (SIGKILL; the caller's waitpid then returns), so that
+// ffmpeg does not go on writing into a folder tdpm removes (issue 27 item
+// 13). A signal already pending when it is made kills the child at once.
+// One child at a time.
+class ChildGuard {
+ public:
+  explicit ChildGuard(int pid);
+  ~ChildGuard();
+  ChildGuard(const ChildGuard&) = delete;
+  ChildGuard& operator=(const ChildGuard&) = delete;
+};
 
 // While an object lives (any thread), a signal's action is postponed until
 // the last one ends: renames of an output pair are never cut in half.

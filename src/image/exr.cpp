@@ -23,6 +23,7 @@
 #include <set>
 
 #include "core/atomic_file.h"
+#include "core/regular_file.h"
 #include "image/exr_header_check.h"
 #include "image/image_limits.h"
 
@@ -37,17 +38,9 @@ bool isColorName(const std::string& n) { return n == "R" || n == "G" || n == "B"
 // readability, directories, and the magic number, so the user gets
 // "No such file or directory" / "not an OpenEXR file" instead of Iex text.
 void precheckInput(const std::string& path) {
-  struct stat st;
-  if (::stat(path.c_str(), &st) != 0) {
-    int err = errno;
-    throw Error(path + ": " + std::strerror(err));
-  }
-  if (S_ISDIR(st.st_mode)) throw Error(path + ": is a directory, not an OpenEXR file");
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) {
-    int err = errno;
-    throw Error(path + ": " + std::strerror(err));
-  }
+  // Regular files only, checked on the opened descriptor: a FIFO would
+  // block open() (and OpenEXR's own open after it) for ever.
+  std::FILE* f = openRegularInput(path, "an OpenEXR file");
   unsigned char magic[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   size_t n = std::fread(magic, 1, 8, f);
   // EXR magic number 20000630 = 0x01312f76, stored little-endian.
@@ -59,6 +52,25 @@ void precheckInput(const std::string& path) {
   std::fclose(f);
   if (!isExr) throw Error(path + ": not an OpenEXR file (bad magic number)");
   if (!bad.empty()) throw Error(path + ": corrupt OpenEXR header: " + bad);
+}
+
+// OpenEXR's name of `c` and whether it can change what was written
+// (PXR24 rounds FLOAT to 24 bits; B44 and DWA are lossy for HALF and, for
+// DWA, FLOAT colour).
+void compressionOf(Imf::Compression c, std::string& name, bool& lossy) {
+  switch (c) {
+    case Imf::NO_COMPRESSION: name = "none"; lossy = false; return;
+    case Imf::RLE_COMPRESSION: name = "rle"; lossy = false; return;
+    case Imf::ZIPS_COMPRESSION: name = "zips"; lossy = false; return;
+    case Imf::ZIP_COMPRESSION: name = "zip"; lossy = false; return;
+    case Imf::PIZ_COMPRESSION: name = "piz"; lossy = false; return;
+    case Imf::PXR24_COMPRESSION: name = "pxr24"; lossy = true; return;
+    case Imf::B44_COMPRESSION: name = "b44"; lossy = true; return;
+    case Imf::B44A_COMPRESSION: name = "b44a"; lossy = true; return;
+    case Imf::DWAA_COMPRESSION: name = "dwaa"; lossy = true; return;
+    case Imf::DWAB_COMPRESSION: name = "dwab"; lossy = true; return;
+    default: name = "unknown (" + std::to_string(int(c)) + ")"; lossy = true; return;
+  }
 }
 
 }  // namespace
@@ -218,6 +230,9 @@ ExrFile readExr(const std::string& path) {
       const Imf::Channel& ch = it.channel();
       if (ch.xSampling != 1 || ch.ySampling != 1) continue;
       result.extra.push_back(Channel{name, std::vector<float>(npix)});
+      result.extra.back().fileType = ch.type == Imf::HALF   ? Channel::FileType::Half
+                                     : ch.type == Imf::UINT ? Channel::FileType::Uint
+                                                            : Channel::FileType::Float;
     }
     // Insert after the vector stopped growing: pointers must stay valid.
     for (Channel& c : result.extra)
@@ -225,6 +240,7 @@ ExrFile readExr(const std::string& path) {
 
     in.setFrameBuffer(fb);
     in.readPixels(dw.min.y, dw.max.y);
+    compressionOf(header.compression(), result.compression, result.lossyCompression);
 
     if (hasY)
       for (Rgb& p : result.color.pixels) p = Rgb(p.r);

@@ -16,6 +16,11 @@ namespace tdpm::image {
 struct Channel {
   std::string name;
   std::vector<float> values;
+  // On reading: the channel's pixel type in the file (values are converted
+  // to float either way). A HALF or UINT channel does not hold the floats
+  // that were written: progressive state layers must be FLOAT.
+  enum class FileType { Float, Half, Uint };
+  FileType fileType = FileType::Float;
 };
 
 struct ExrFile {
@@ -25,6 +30,11 @@ struct ExrFile {
   // "tdpm/seed", "tdpm/render_seconds". On reading: every string attribute
   // of the header (also foreign ones such as "owner" or "comments").
   std::map<std::string, std::string> metadata;
+  // On reading: the file's compression, by OpenEXR's name ("zip", "dwaa",
+  // ...), and whether it is lossy (DWAA, DWAB, B44, B44A; PXR24 for FLOAT
+  // channels): such a file's floats are not the ones that were written.
+  std::string compression;
+  bool lossyCompression = false;
 
   // The extra channel called `name`, or nullptr.
   const Channel* findChannel(const std::string& name) const;

@@ -44,7 +44,6 @@ constexpr uint64_t kBatchesPerChunk = 256;
 // kMaxPathsPerPhoton paths per wanted photon (both reported as warnings).
 constexpr uint64_t kMaxPilotPaths = uint64_t(1) << 20;
 constexpr uint64_t kMaxPilotRays = uint64_t(1) << 21;
-constexpr double kMaxPathsPerPhoton = 1000.0;
 
 // Radical inverse in base 2 with a random XOR scramble: a (0,1)-sequence,
 // so every prefix of the path times is stratified over the shutter.

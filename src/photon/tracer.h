@@ -75,6 +75,10 @@ struct TraceSettings {
 
 // Paths per batch: the unit of emission counts and of TraceSettings::firstPath.
 constexpr uint64_t kPathsPerBatch = 1024;
+// A map emits at most this many paths per wanted photon (a scene that
+// stores almost nothing stops there, with a warning): also the bound a
+// progressive state's paths per pass must keep (render/progressive_check.h).
+constexpr double kMaxPathsPerPhoton = 1000.0;
 
 // A caustic photon's last specular vertex, and the normal of the surface
 // it was stored on, facing the side it arrived from.

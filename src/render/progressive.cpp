@@ -26,6 +26,7 @@
 #include "render/memory_budget.h"
 #include "render/photon_integrator.h"
 #include "render/photon_map.h"
+#include "render/progressive_check.h"
 #include "render/sample_allocation.h"
 #include "render/tile_loop.h"
 #include "sampling/sampler.h"
@@ -315,9 +316,12 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
     ms.trace.storedWanted = wanted;
     auto it = state.scalars.find(key);
     if (it != state.scalars.end()) {
+      // A resumed value was checked (render/progressive_check.h): a whole
+      // number of batches, small enough for every pass index.
       uint64_t paths = uint64_t(it->second);
       if (paths == 0) ms.trace.storedWanted = 0;
       ms.trace.paths = paths;
+      TDPM_ASSERT(paths == 0 || uint64_t(pass) + 1 <= UINT64_MAX / paths, "progressive photon path index overflows");
       ms.trace.firstPath = uint64_t(pass) * paths;
     }
     std::unique_ptr<PhotonMap> m = buildPhotonMap(scene, ms, progress);
@@ -374,20 +378,42 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
 
 // Adds pass state.passesDone (its pixel means and figures) into the state:
 // the one place the sums grow, for one process and for rank 0 of a job
-// alike, so both make the same float operations in the same order.
-void addPass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state, const float* mean,
-             const std::vector<uint32_t>& counts, const PassFigures& f, RenderStats& st) {
+// alike, so both make the same float operations in the same order. Each
+// sum is formed in double and rounded once to the float layer; a value
+// beyond the largest float (a pass mean of 1e20 squares to 1e40) cannot
+// be kept: the first such pixel is returned as an error message (empty:
+// none), and the caller refuses the render (issue 27 item 7: it wrote
+// +Inf sums and a variance of 3.4e38, and resumed them, with exit 0).
+std::string addPass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state, const float* mean,
+                    const std::vector<uint32_t>& counts, const PassFigures& f, RenderStats& st) {
   const int pass = state.passesDone;
-  const size_t n = size_t(scene.camera.width()) * size_t(scene.camera.height());
+  const int width = scene.camera.width();
+  const size_t n = size_t(width) * size_t(scene.camera.height());
   float* sum[3] = {state.layers["sum.R"].data(), state.layers["sum.G"].data(), state.layers["sum.B"].data()};
   float* sq[3] = {state.layers["sumsq.R"].data(), state.layers["sumsq.G"].data(), state.layers["sumsq.B"].data()};
   float* count = state.layers["spp"].data();
   const float spp = float(opt.spp);
+  std::string overflow;
   for (size_t i = 0; i < n; ++i) {
     for (int c = 0; c < 3; ++c) {
-      const float m = mean[3 * i + size_t(c)];
-      sum[c][i] += m;
-      sq[c][i] += m * m;
+      const double m = double(mean[3 * i + size_t(c)]);
+      const double a = double(sum[c][i]) + m, b = double(sq[c][i]) + m * m;
+      const bool sumFits = std::fabs(a) <= double(FLT_MAX);
+      if (sumFits && b <= double(FLT_MAX)) {
+        sum[c][i] = float(a);
+        sq[c][i] = float(b);
+      } else if (overflow.empty()) {  // the layers keep their old values: the render is refused
+        const char* names[2][3] = {{"sum.R", "sum.G", "sum.B"}, {"sumsq.R", "sumsq.G", "sumsq.B"}};
+        const bool inSum = !sumFits;
+        char buf[400];
+        std::snprintf(buf, sizeof buf,
+                      "progressive pass %d: pixel (%zu, %zu) has the pass value %.3g, and its %s (%.3g) is beyond the "
+                      "largest float (%.3g) the progressive state keeps: the scene is too bright for --progressive "
+                      "(scale its lights down, or render with --fixed-budget)",
+                      pass + 1, i % size_t(width), i / size_t(width), m, names[inSum ? 0 : 1][c], inSum ? a : b,
+                      double(FLT_MAX));
+        overflow = buf;
+      }
     }
     count[i] += counts.empty() ? spp : float(counts[i]);
   }
@@ -410,6 +436,7 @@ void addPass(const Scene& scene, const RenderOptions& opt, ProgressiveState& sta
   sc["kernel.spatial_radius"] = double(k.caustic.spatialRadius);
   sc["kernel.half_window"] = timeDependent ? double(k.caustic.halfWindow) : 0.0;
   sc["seconds"] = scalarOr(state, "seconds", 0) + f.seconds;
+  return overflow;
 }
 
 }  // namespace
@@ -465,7 +492,8 @@ void runProgressivePass(const Scene& scene, const RenderOptions& opt, Progressiv
                         const Progress& progress, RenderStats& st, const std::vector<uint32_t>& counts) {
   std::vector<float> mean;
   PassFigures f = computePass(scene, opt, state, state.passesDone, counts, progress, st, mean, {});
-  addPass(scene, opt, state, mean.data(), counts, f, st);
+  std::string overflow = addPass(scene, opt, state, mean.data(), counts, f, st);
+  if (!overflow.empty()) throw Error(overflow);
 }
 
 Film filmFromState(const ProgressiveState& state, int width, int height) {
@@ -563,6 +591,7 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
   if (!comm.distributed()) {
     for (;;) {
       if (opt.passes > 0 && state.passesDone >= opt.passes) break;
+      if (state.passesDone >= maxProgressivePasses()) break;  // what a resume accepts (progressive_check.h)
       runProgressivePass(scene, opt, state, progress, st, counts);
       progress.at(position());
       if (limit > 0 && timer.seconds() >= limit) break;
@@ -579,7 +608,8 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
     bool roundDropped = false;
     for (bool stop = false; !stop;) {
       const int first = state.passesDone;
-      const int inRound = opt.passes > 0 ? std::min(N, opt.passes - first) : N;
+      const int inRound =
+          std::min(opt.passes > 0 ? std::min(N, opt.passes - first) : N, maxProgressivePasses() - first);
       if (inRound <= 0) break;
       const bool has = rank < inRound;
       const bool needPilot = !hasPilot(state);
@@ -615,9 +645,12 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
       dist::combineRoundOnRoot(comm, figures, has,
                                [&](const double* v, size_t) { roundFigures.push_back(PassFigures::unpack(v)); });
       size_t next = 0;
+      std::string overflow;
       dist::combineRoundOnRoot(comm, mean, has, [&](const float* v, size_t) {
-        addPass(scene, opt, state, v, counts, roundFigures[next++], st);
+        std::string e = addPass(scene, opt, state, v, counts, roundFigures[next++], st);
+        if (overflow.empty()) overflow = e;
       });
+      dist::raiseIfAnyFailed(comm, overflow);  // rank 0 alone adds: every rank learns it
       state.passesDone = first + inRound;
       if (comm.root()) progress.at(position());
       // Stop when rank 0 says so (time limit) or any rank was asked to stop

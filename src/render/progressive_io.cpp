@@ -42,6 +42,9 @@ std::vector<std::string> splitNames(const std::string& s) {
 
 }  // namespace
 
+DamagedStateError::DamagedStateError(const std::string& path, const std::string& what)
+    : Error("damaged progressive state: " + path + ": " + what) {}
+
 std::string exactDoubleText(double v) {
   if (std::isnan(v)) return "nan";
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
@@ -93,10 +96,7 @@ void addProgressiveState(ProgressiveState&& state, image::ExrFile& exr) {
 std::optional<ProgressiveState> progressiveStateOf(const image::ExrFile& exr, const std::string& path) {
   auto version = exr.metadata.find(kAttr + "version");
   if (version == exr.metadata.end()) return std::nullopt;
-  auto bad = [&](const std::string& what) {
-    return Error(path + ": damaged progressive state: " + what + " (the file's " + kAttr + "* attributes and " +
-                 kLayer + "* layers)");
-  };
+  auto bad = [&](const std::string& what) { return DamagedStateError(path, what); };
   if (version->second != kLayoutVersion)
     throw Error(path + ": progressive state of layout version '" + version->second + "', this tdpm reads version " +
                 kLayoutVersion);
@@ -129,11 +129,20 @@ std::optional<ProgressiveState> progressiveStateOf(const image::ExrFile& exr, co
       state.scalars[name.substr(7)] = v;
     }
   }
+  // The layers hold floats that must come back exactly: a file converted
+  // to HALF or to a lossy compression no longer does (issue 27 item 3).
+  if (exr.lossyCompression)
+    throw bad("the file is " + exr.compression + "-compressed, which is lossy: its " + kLayer +
+              "* layers are not the floats that were written");
   std::set<std::string> listed;
   for (const std::string& name : splitNames(need("layers"))) {
     if (name.empty() || !listed.insert(name).second) throw bad(kAttr + "layers lists '" + name + "' badly");
     const image::Channel* c = exr.findChannel(kLayer + name);
     if (!c) throw bad("layer " + kLayer + name + " is missing");
+    if (c->fileType != image::Channel::FileType::Float)
+      throw bad("layer " + kLayer + name + " is stored as " +
+                (c->fileType == image::Channel::FileType::Half ? "HALF" : "UINT") +
+                ", not FLOAT: it does not hold the floats that were written");
     state.layers[name] = c->values;
   }
   for (const image::Channel& c : exr.extra)

@@ -18,6 +18,7 @@
 #include <optional>
 #include <string>
 
+#include "core/error.h"
 #include "image/exr.h"
 #include "render/progressive_state.h"
 
@@ -37,11 +38,20 @@ void addProgressiveState(const ProgressiveState& state, image::ExrFile& exr);
 // scalars, settings and fingerprint, its layers are left empty.
 void addProgressiveState(ProgressiveState&& state, image::ExrFile& exr);
 
+// "damaged progressive state: <path>: <what>": a file's state that cannot
+// be what a render wrote (here and render/progressive_check.h).
+struct DamagedStateError : Error {
+  DamagedStateError(const std::string& path, const std::string& what);
+};
+
 // The state in `exr`, read from the file `path` (for messages); nullopt
-// when the file carries none (no "tdpm/progressive/version" attribute). A
-// state that is there but damaged (another layout version, an attribute
-// that does not parse, a listed layer missing) throws tdpm::Error
-// "<path>: ..." naming the attribute or layer.
+// when the file carries none (no "tdpm/progressive/version" attribute).
+// Another layout version throws tdpm::Error "<path>: ...". A state that is
+// there but damaged (an attribute that does not parse, a listed layer
+// missing or unlisted, a layer stored as HALF or UINT, a lossy compression
+// such as DWAA, DWAB, B44 or PXR24) throws DamagedStateError naming the
+// attribute or layer. Whether the values fit together and fit the render
+// is checkProgressiveState's (render/progressive_check.h).
 std::optional<ProgressiveState> progressiveStateOf(const image::ExrFile& exr, const std::string& path);
 
 // "%.17g": the shortest printf format that reads back (strtod) to the same
