@@ -17,6 +17,8 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/memory.h"
+#include "core/regular_file.h"
 #include "import/pbrt_importer.h"
 #include "sampling/filter.h"
 #include "scene/limits.h"
@@ -36,17 +38,31 @@ std::string fmtNum(double v) {
   return s.str();
 }
 
-std::string readWholeFile(const std::string& path, const std::string& where) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw Error(where + path + ": cannot read scene file: it is a directory");
+void Importer::parseFile(const std::string& path, int depth, const std::string& where) {
+  namespace L = scene::limits;
+  RegularFileCheck f = checkRegularFile(path);
+  if (!f.ok) throw Error(where + path + ": cannot read scene file: " + f.problem);
+  if (f.size > L::kMaxPbrtFileBytes)
+    throw Error(where + path + ": pbrt file is too large (" + std::to_string(f.size) + " bytes; at most " +
+                std::to_string(L::kMaxPbrtFileBytes >> 20) + " MiB per file; put large meshes in PLY files)");
+  if (f.size > L::kMaxPbrtTotalBytes - bytesRead_)
+    throw Error(where + path + ": the scene's files together are larger than " + std::to_string(L::kMaxPbrtTotalBytes >> 20) +
+                " MiB (" + std::to_string(bytesRead_) + " bytes read before this " + std::to_string(f.size) +
+                "-byte file; is a file included many times?)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(where + path + ": cannot read scene file (" + std::strerror(errno) + ")");
-  // Not a device or a pipe (Include "/dev/zero" would never end).
-  if (!std::filesystem::is_regular_file(path, ec)) throw Error(where + path + ": cannot read scene file: not a regular file");
-  std::ostringstream text;
-  text << in.rdbuf();
+  // Read at most one chunk over the budget, in case the file grew since the stat.
+  const uint64_t budget = std::min(L::kMaxPbrtFileBytes, L::kMaxPbrtTotalBytes - bytesRead_);
+  std::string text;
+  char chunk[1 << 16];
+  while (in.read(chunk, sizeof chunk), in.gcount() > 0) {
+    text.append(chunk, size_t(in.gcount()));
+    if (text.size() > budget) throw Error(where + path + ": pbrt file grew past its size limit while being read");
+  }
   if (in.bad()) throw Error(where + path + ": error while reading scene file");
-  return text.str();
+  bytesRead_ += text.size();
+  result.inputFiles.push_back(path);
+  parseText(text, path, depth);
 }
 
 // A relative path is looked up beside the file that names it; if it is not
@@ -150,6 +166,28 @@ void Importer::note(const Loc& at, const std::string& what) {
   result.notes.push_back(at.str() + ": " + what);
 }
 
+void Importer::checkNesting(const Loc& at, const std::string& stmt) const {
+  if (stack_.size() >= size_t(scene::limits::kMaxPbrtNesting))
+    failAt(at, stmt + ": AttributeBegin/TransformBegin/ObjectBegin nested more than " +
+                   std::to_string(scene::limits::kMaxPbrtNesting) + " deep");
+}
+
+// Adds n triangles to the scene's count, refusing before the copy is made
+// when the count passes kMaxPbrtTriangles or its estimated memory the
+// memory available when the import began.
+void Importer::countTriangles(uint64_t n, const Loc& at, const std::string& what) {
+  namespace L = scene::limits;
+  uint64_t total = triangles_ + n;
+  if (total > L::kMaxPbrtTriangles)
+    failAt(at, what + ": the scene would have " + std::to_string(total) + " triangles, more than tdpm's limit of " +
+                   std::to_string(L::kMaxPbrtTriangles) + " (instanced copies count in full)");
+  if (memoryAtStart_ > 0 && total * L::kPbrtBytesPerTriangle > memoryAtStart_)
+    failAt(at, what + ": the scene would have " + std::to_string(total) + " triangles, about " +
+                   std::to_string((total * L::kPbrtBytesPerTriangle) >> 20) + " MiB, more than the " +
+                   std::to_string(memoryAtStart_ >> 20) + " MiB of memory available");
+  triangles_ = total;
+}
+
 void Importer::requireWorld(const Loc& at, const std::string& stmt) const {
   if (!inWorld_) failAt(at, stmt + " is only allowed after WorldBegin");
 }
@@ -226,7 +264,13 @@ void Importer::parseText(const std::string& text, const std::string& file, int d
     const Token& word = c.next();
     if (word.kind != Token::Kind::Word)
       failAt({file, word.line}, "expected a statement (such as Shape or WorldBegin), got '" + word.text + "'");
-    statement(c, word, depth);
+    try {
+      statement(c, word, depth);
+    } catch (const std::bad_alloc&) {
+      // Under a memory limit (ulimit -v) the budgets below may not be
+      // reached first: still say where.
+      failAt({file, word.line}, word.text + ": out of memory while importing this statement");
+    }
   }
 }
 
@@ -312,6 +356,7 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
     inWorld_ = false;
     worldEnded_ = true;
   } else if (s == "AttributeBegin" || s == "TransformBegin") {
+    checkNesting(at, s);
     stack_.push_back({gs_, s == "AttributeBegin", at});
   } else if (s == "AttributeEnd" || s == "TransformEnd") {
     bool attribute = s == "AttributeEnd";
@@ -327,6 +372,9 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
   } else if (s == "Include" || s == "Import") {
     std::string name = c.string(s);
     if (depth + 1 > kMaxIncludeDepth) failAt(at, s + " \"" + name + "\": nested more than 32 deep (an include cycle?)");
+    if (++includes_ > scene::limits::kMaxPbrtIncludes)
+      failAt(at, s + " \"" + name + "\": more than " + std::to_string(scene::limits::kMaxPbrtIncludes) +
+                     " Include/Import statements in one scene (files that include each other repeatedly?)");
     parseFile(resolvePath(name, c.file(), mainDir), depth + 1, at.str() + ": " + s + ": ");
   } else if (s == "Shape") {
     requireWorld(at, s);
@@ -370,6 +418,7 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
     requireWorld(at, s);
     std::string name = c.string(s);
     if (currentInstance_) failAt(at, "ObjectBegin \"" + name + "\" inside the definition of \"" + currentInstanceName_ + "\"");
+    checkNesting(at, s);
     stack_.push_back({gs_, true, at});
     currentInstance_ = &instances_[name];
     currentInstance_->clear();
@@ -387,10 +436,16 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
     if (currentInstance_) failAt(at, "ObjectInstance inside an object definition is not supported");
     auto it = instances_.find(name);
     if (it == instances_.end()) failAt(at, "ObjectInstance: no object named \"" + name + "\" has been defined");
+    // Pre-flight: once an object's triangle count is known (its first
+    // instance), every further copy is counted before it is made.
+    auto known = instanceTriangles_.find(name);
+    if (known != instanceTriangles_.end()) countTriangles(known->second, at, "ObjectInstance \"" + name + "\"");
+    uint64_t before = triangles_;
     for (const ShapeRecord& rec : it->second) {
       Mat ctm[2] = {gs_.ctm[0] * rec.ctm[0], gs_.ctm[1] * rec.ctm[1]};
       emitShape(rec, ctm, at);
     }
+    if (known == instanceTriangles_.end()) instanceTriangles_[name] = triangles_ - before;
   } else if (s == "ReverseOrientation") {
     failAt(at, "ReverseOrientation is not supported (tdpm cannot flip a sphere's or an emitter's orientation)");
   } else {
@@ -475,6 +530,8 @@ void Importer::worldBegin(const Loc& at) {
   struct Frame3 { Vec3f pos, fwd, up; };
   Frame3 f[2];
   for (int i = 0; i < 2; ++i) {
+    std::string degenerate = scaleProblem(C[i]);
+    if (!degenerate.empty()) failAt(camAt, "Camera: the camera transform is unusable: " + degenerate);
     std::optional<Pose> p = decompose(C[i]);
     bool similar = p && std::fabs(std::fabs(p->scale.x) - std::fabs(p->scale.y)) <= 1e-5f * std::fabs(p->scale.x) &&
                    std::fabs(std::fabs(p->scale.x) - std::fabs(p->scale.z)) <= 1e-5f * std::fabs(p->scale.x);
@@ -568,7 +625,12 @@ void Importer::worldBegin(const Loc& at) {
     if (!(radius > 0)) failAt(iat, "Integrator \"sppm\": radius must be positive");
     int64_t per = perIteration > 0 ? perIteration : int64_t(width) * height;
     r.method = "time";
-    r.photons = std::min(kMaxPhotons, per * iterations);
+    if (per > kMaxPhotons / iterations)
+      failAt(iat, "Integrator \"sppm\": photonsperiteration x numiterations = " + std::to_string(per) + " x " +
+                      std::to_string(iterations) + " photons is more than tdpm's limit of " + std::to_string(kMaxPhotons) +
+                      " (render.photons)");
+    r.photons = per * iterations;
+    result.settingSources["photons"] = iat.str() + ": Integrator \"sppm\" (photonsperiteration x numiterations)";
     r.maxRadius = float(radius);
     ip.markUsed("seed");
     note(iat, "Integrator \"sppm\" mapped to tdpm's time-dependent photon method with photons = photonsperiteration x "
@@ -589,11 +651,21 @@ void Importer::finish(const std::string& file) {
     failAt(stack_.back().at, std::string(stack_.back().attribute ? "AttributeBegin" : "TransformBegin") + " without a matching End");
   if (imagingRatio_ != 1) {
     float k = float(imagingRatio_);
-    for (auto& l : result.scene.lights) l.power = l.power * k;
-    result.scene.background = result.scene.background * k;
+    for (auto& l : result.scene.lights) {
+      l.power = l.power * k;
+      if (!std::isfinite(l.power.r) || !std::isfinite(l.power.g) || !std::isfinite(l.power.b))
+        failAt(film_.at, "Film: pbrt-v4 scales the image by exposure time x ISO / 100 = " + fmtNum(imagingRatio_) + ", which makes " +
+                             l.name + " infinitely bright (its power overflows a float)");
+    }
+    if (!result.scene.background.isBlack()) result.scene.background = result.scene.background * k;
+    if (!std::isfinite(result.scene.background.r) || !std::isfinite(result.scene.background.g) ||
+        !std::isfinite(result.scene.background.b))
+      failAt(film_.at, "Film: pbrt-v4 scales the image by exposure time x ISO / 100 = " + fmtNum(imagingRatio_) +
+                           ", which makes the infinite light's radiance overflow a float");
     result.notes.push_back(film_.at.str() + ": Film: pbrt-v4 scales the image by exposure time x ISO / 100 = " +
                            fmtNum(imagingRatio_) + "; the import scales every light by it");
   }
+  validateAsJson();
 }
 
 }  // namespace tdpm::pbrt::detail
@@ -602,6 +674,7 @@ namespace tdpm::pbrt {
 
 ImportResult importPbrtText(const std::string& text, const std::string& path) {
   detail::Importer im;
+  im.start();
   im.result.scene.sourcePath = path;
   im.mainDir = std::filesystem::path(path).parent_path().string();
   im.parseText(text, path, 0);
@@ -611,6 +684,7 @@ ImportResult importPbrtText(const std::string& text, const std::string& path) {
 
 ImportResult importPbrtFile(const std::string& path) {
   detail::Importer im;
+  im.start();
   im.result.scene.sourcePath = path;
   im.mainDir = std::filesystem::path(path).parent_path().string();
   im.parseFile(path, 0, "");

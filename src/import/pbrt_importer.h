@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/memory.h"
 #include "import/pbrt_import.h"
 #include "import/pbrt_math.h"
 #include "import/pbrt_params.h"
@@ -28,7 +29,6 @@ struct Loc {
 
 [[noreturn]] void failAt(const Loc& at, const std::string& what);
 std::string fmtNum(double v);
-std::string readWholeFile(const std::string& path, const std::string& where);
 // A relative path is looked up beside the file that names it; if it is not
 // there but is beside the main scene file (pbrt's search directory), that
 // one is used, so scenes written for pbrt's rule load too.
@@ -95,11 +95,13 @@ class Importer {
  public:
   ImportResult result;
 
-  void parseFile(const std::string& path, int depth, const std::string& where) {
-    std::string text = readWholeFile(path, where);
-    parseText(text, path, depth);
-  }
+  // Reads `path` within the import's budgets (scene/limits.h): a regular
+  // file (checked before open: a FIFO would block), at most
+  // kMaxPbrtFileBytes, and kMaxPbrtTotalBytes for all files together.
+  // `where` is the Include's "file:line: Include: " (empty for the main file).
+  void parseFile(const std::string& path, int depth, const std::string& where);
   void parseText(const std::string& text, const std::string& file, int depth);
+  void start() { memoryAtStart_ = availableMemoryBytes(); }
   void finish(const std::string& file);
   std::string mainDir;  // pbrt's search directory: the main scene file's
 
@@ -133,6 +135,8 @@ class Importer {
   void requireWorld(const Loc& at, const std::string& stmt) const;
   void requireOptions(const Loc& at, const std::string& stmt) const;
   void mapPixelFilter(scene::RenderSettings& r, bool v4Film);
+  void checkNesting(const Loc& at, const std::string& stmt) const;
+  void countTriangles(uint64_t n, const Loc& at, const std::string& what);
 
   GraphicsState gs_;
   std::vector<StackEntry> stack_;
@@ -145,6 +149,20 @@ class Importer {
   std::string currentInstanceName_;
   std::set<std::string> materialNames_;
   std::set<std::string> notedKinds_;
+
+  // budgets (scene/limits.h)
+  uint64_t bytesRead_ = 0;
+  int includes_ = 0;
+  uint64_t triangles_ = 0;
+  uint64_t memoryAtStart_ = 0;  // MemAvailable when the import began (0: unknown)
+  std::map<std::string, uint64_t> instanceTriangles_;  // per object, once instanced
+
+  // Where each scene.objects[i] / scene.lights[i] / the background came
+  // from, to name the pbrt statement when the JSON checks refuse it.
+  std::vector<Loc> objectAt_, lightAt_;
+  Loc backgroundAt_;
+  void validateAsJson();
+  Loc locateJsonPath(const std::string& path) const;
 
   bool inWorld_ = false, sawWorld_ = false, worldEnded_ = false;
   float transformStart_ = 0, transformEnd_ = 1;

@@ -274,6 +274,8 @@ void Importer::lightSource(const std::string& type, const ParamSet& ps, const Lo
     Vec3f from = ps.getPoint("from", {0, 0, 0}), to = ps.getPoint("to", {0, 0, 1});
     Vec3f dir = M.vector(to - from);
     if (!(length(dir) > 0)) failAt(at, "LightSource \"spot\": from and to coincide");
+    std::string degenerate = scaleProblem(M);
+    if (!degenerate.empty()) failAt(at, "LightSource \"spot\": its transform is unusable: " + degenerate);
     std::optional<Pose> p = decompose(M);
     if (!p || std::fabs(std::fabs(p->scale.x) - std::fabs(p->scale.y)) > 1e-5f * std::fabs(p->scale.x) ||
         std::fabs(std::fabs(p->scale.x) - std::fabs(p->scale.z)) > 1e-5f * std::fabs(p->scale.x))
@@ -303,12 +305,14 @@ void Importer::lightSource(const std::string& type, const ParamSet& ps, const Lo
     for (const char* q : {"nsamples", "samples"}) ps.markUsed(q);
     ps.checkAllUsed();
     result.scene.background = result.scene.background + L;
+    backgroundAt_ = at;
     return;
   } else {
     failAt(at, "LightSource \"" + type + "\" is not supported (point, spot, distant, infinite)");
   }
   ps.checkAllUsed();
   result.scene.lights.push_back(l);
+  lightAt_.push_back(at);
 }
 
 // ------------------------------------------------------------ shapes
@@ -334,9 +338,9 @@ struct Geometry {
 };
 }  // namespace
 
-static std::vector<Vec3f> readPoints(const ParamSet& ps, const std::string& name) {
+static std::vector<Vec3f> readPoints(const ParamSet& ps, const std::string& name, const Loc& at) {
   const Param* p = ps.find(name);
-  if (!p) throw Error(ps.file() + ": " + ps.statement() + ": missing parameter \"point3 " + name + "\"");
+  if (!p) failAt(at, ps.statement() + ": missing parameter \"point3 " + name + "\"");
   if (p->type != "point3") ps.fail(*p, "expected type point3");
   std::vector<double> v = ps.getFloats(name);
   if (v.empty() || v.size() % 3) ps.fail(*p, "expected a non-empty multiple of 3 numbers, got " + std::to_string(v.size()));
@@ -345,13 +349,14 @@ static std::vector<Vec3f> readPoints(const ParamSet& ps, const std::string& name
   return out;
 }
 
-static std::vector<uint32_t> readIndices(const ParamSet& ps, size_t vertexCount, size_t per, const std::string& what) {
+static std::vector<uint32_t> readIndices(const ParamSet& ps, size_t vertexCount, size_t per, const std::string& what,
+                                         const Loc& at) {
   const Param* p = ps.find("indices");
   std::vector<uint32_t> out;
   if (!p) {
     if (vertexCount != per)
-      throw Error(ps.file() + ": " + ps.statement() + ": missing parameter \"integer indices\" (only a single " + what +
-                  " of " + std::to_string(per) + " points may omit it)");
+      failAt(at, ps.statement() + ": missing parameter \"integer indices\" (only a single " + what + " of " +
+                     std::to_string(per) + " points may omit it)");
     for (uint32_t i = 0; i < per; ++i) out.push_back(i);
     return out;
   }
@@ -380,7 +385,9 @@ static void addQuads(const std::vector<Vec3f>& P, const std::vector<uint32_t>& q
   }
 }
 
-static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(const std::string&)>& note, const std::string& mainDir) {
+// `inputs` collects the files read (PLY meshes).
+static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(const std::string&)>& note, const std::string& mainDir,
+                             std::vector<std::string>& inputs) {
   const ParamSet& ps = rec.params;
   Geometry g;
   if (rec.type == "sphere") {
@@ -393,8 +400,8 @@ static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(co
     g.radius = float(r);
   } else if (rec.type == "trianglemesh" || rec.type == "bilinearmesh") {
     bool bilinear = rec.type == "bilinearmesh";
-    std::vector<Vec3f> P = readPoints(ps, "P");
-    std::vector<uint32_t> idx = readIndices(ps, P.size(), bilinear ? 4 : 3, bilinear ? "patch" : "triangle");
+    std::vector<Vec3f> P = readPoints(ps, "P", rec.at);
+    std::vector<uint32_t> idx = readIndices(ps, P.size(), bilinear ? 4 : 3, bilinear ? "patch" : "triangle", rec.at);
     std::vector<double> uv = ps.getFloats(ps.has("uv") ? "uv" : "st");
     if (!uv.empty()) {
       if (uv.size() != 2 * P.size()) ps.fail(*ps.find(ps.has("uv") ? "uv" : "st"), "expected 2 numbers per point");
@@ -432,7 +439,9 @@ static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(co
     ps.markUsed("edgelength");
     PlyMesh ply;
     try {
-      ply = readPly(resolvePath(file, rec.at.file, mainDir));
+      std::string path = resolvePath(file, rec.at.file, mainDir);
+      ply = readPly(path);
+      inputs.push_back(path);
     } catch (const Error& e) {
       failAt(rec.at, std::string("Shape \"plymesh\": ") + e.what());
     }
@@ -461,6 +470,9 @@ Importer::MotionPlan Importer::planMotion(const Mat ctm[2], const Loc& at, const
   std::optional<Pose> p[2];
   for (int i = 0; i < 2; ++i) {
     p[i] = decompose(ctm[i]);
+    std::string degenerate = scaleProblem(ctm[i]);
+    if (!degenerate.empty())
+      failAt(at, what + ": its " + (i ? "EndTime" : "StartTime") + " transform is unusable: " + degenerate);
     if (!p[i] || ctm[i].det3() < 0)
       failAt(at, what + ": its " + (i ? "EndTime" : "StartTime") +
                      " transform has shear, a scale along rotated axes or a mirror; pbrt would interpolate its polar "
@@ -564,7 +576,9 @@ static CheckerFrame placeChecker(const std::vector<Vec3f>& world, const std::vec
 }
 
 void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& instanceAt) {
-  Geometry g = makeGeometry(rec, [&](const std::string& w) { note(rec.at, w); }, mainDir);
+  Geometry g = makeGeometry(rec, [&](const std::string& w) { note(rec.at, w); }, mainDir, result.inputFiles);
+  countTriangles(g.indices.size() / 3, instanceAt.file.empty() ? rec.at : instanceAt,
+                 instanceAt.file.empty() ? "Shape \"" + rec.type + "\"" : "ObjectInstance (Shape \"" + rec.type + "\" at " + rec.at.str() + ")");
   const MaterialSlot& mat = materials_[size_t(rec.material)];
   if (rec.area) {
     if (g.sphere) failAt(rec.at, "Shape \"sphere\" with an AreaLightSource: tdpm's area lights are rectangles");
@@ -580,6 +594,8 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
     o.shape.type = scene::ShapeDesc::Type::Sphere;
     o.shape.radius = g.radius;
     if (!plan.moving) {
+      std::string degenerate = scaleProblem(plan.still);
+      if (!degenerate.empty()) failAt(rec.at, "Shape \"sphere\": its transform is unusable: " + degenerate);
       std::optional<Pose> p = decompose(plan.still);
       if (!p || !nearlyUniform(p->scale))
         failAt(rec.at, "Shape \"sphere\" under a non-uniform scale or shear (an ellipsoid) is not supported");
@@ -613,6 +629,7 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
       result.scene.materials.push_back(m);
       o.material = uint32_t(result.scene.materials.size() - 1);
       result.scene.objects.push_back(std::move(o));
+      objectAt_.push_back(rec.at);
       return;
     }
     if (!plan.moving) {
@@ -632,6 +649,7 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
   }
   o.material = materialIndex(rec.material);
   result.scene.objects.push_back(std::move(o));
+  objectAt_.push_back(rec.at);
 }
 
 void Importer::emitAreaLight(const ShapeRecord& rec, const std::vector<Vec3f>& verts, const std::vector<uint32_t>& idx,
@@ -690,6 +708,7 @@ void Importer::emitAreaLight(const ShapeRecord& rec, const std::vector<Vec3f>& v
   if (!black)
     note(rec.at, what + ": tdpm's area lights do not reflect light; the emitter's material is ignored");
   result.scene.lights.push_back(l);
+  lightAt_.push_back(rec.area->at);
 }
 
 }  // namespace tdpm::pbrt::detail

@@ -165,7 +165,7 @@ Vec3f canonicalDirection(Vec3f d) {
   return d;
 }
 
-SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& jsonPath) {
+SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& jsonPath, bool meshText) {
   SceneJson out;
   std::filesystem::path jp(jsonPath);
   std::string stem = jp.stem().string();
@@ -199,7 +199,7 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
       case scene::ShapeDesc::Type::Box: j["shape"] = Json{{"type", "box"}, {"size", vec(s.size)}}; break;
       case scene::ShapeDesc::Type::Mesh: {
         std::string name = stem + ".mesh" + std::to_string(out.meshFiles.size()) + ".obj";
-        out.meshFiles.push_back({(jp.parent_path() / name).string(), objText(s)});
+        out.meshFiles.push_back({(jp.parent_path() / name).string(), meshText ? objText(s) : std::string()});
         j["shape"] = Json{{"type", "mesh"}, {"file", name}};
         break;
       }
