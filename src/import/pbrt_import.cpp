@@ -172,20 +172,20 @@ void Importer::checkNesting(const Loc& at, const std::string& stmt) const {
                    std::to_string(scene::limits::kMaxPbrtNesting) + " deep");
 }
 
-// Adds n triangles to the scene's count, refusing before the copy is made
+// Adds n triangles to the scene's count (with !add: only checks), refusing before the copy is made
 // when the count passes kMaxPbrtTriangles or its estimated memory the
 // memory available when the import began.
-void Importer::countTriangles(uint64_t n, const Loc& at, const std::string& what) {
+void Importer::countTriangles(uint64_t n, const Loc& at, const std::string& what, bool add) {
   namespace L = scene::limits;
   uint64_t total = triangles_ + n;
-  if (total > L::kMaxPbrtTriangles)
+  if (total > maxTriangles)
     failAt(at, what + ": the scene would have " + std::to_string(total) + " triangles, more than tdpm's limit of " +
-                   std::to_string(L::kMaxPbrtTriangles) + " (instanced copies count in full)");
+                   std::to_string(maxTriangles) + " (instanced copies count in full)");
   if (memoryAtStart_ > 0 && total * L::kPbrtBytesPerTriangle > memoryAtStart_)
     failAt(at, what + ": the scene would have " + std::to_string(total) + " triangles, about " +
                    std::to_string((total * L::kPbrtBytesPerTriangle) >> 20) + " MiB, more than the " +
                    std::to_string(memoryAtStart_ >> 20) + " MiB of memory available");
-  triangles_ = total;
+  if (add) triangles_ = total;
 }
 
 void Importer::requireWorld(const Loc& at, const std::string& stmt) const {
@@ -439,7 +439,7 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
     // Pre-flight: once an object's triangle count is known (its first
     // instance), every further copy is counted before it is made.
     auto known = instanceTriangles_.find(name);
-    if (known != instanceTriangles_.end()) countTriangles(known->second, at, "ObjectInstance \"" + name + "\"");
+    if (known != instanceTriangles_.end()) countTriangles(known->second, at, "ObjectInstance \"" + name + "\"", false);
     uint64_t before = triangles_;
     for (const ShapeRecord& rec : it->second) {
       Mat ctm[2] = {gs_.ctm[0] * rec.ctm[0], gs_.ctm[1] * rec.ctm[1]};
@@ -672,9 +672,10 @@ void Importer::finish(const std::string& file) {
 
 namespace tdpm::pbrt {
 
-ImportResult importPbrtText(const std::string& text, const std::string& path) {
+ImportResult importPbrtText(const std::string& text, const std::string& path, uint64_t maxTriangles) {
   detail::Importer im;
   im.start();
+  if (maxTriangles) im.maxTriangles = maxTriangles;
   im.result.scene.sourcePath = path;
   im.mainDir = std::filesystem::path(path).parent_path().string();
   im.parseText(text, path, 0);

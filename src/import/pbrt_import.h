@@ -4,6 +4,7 @@
 // exactly is an error naming file:line and the statement or parameter;
 // parameters that only change quality produce a one-line note instead.
 #pragma once
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -28,7 +29,9 @@ struct ImportResult {
 // Reads `path`; Include/Import are resolved relative to the including file.
 ImportResult importPbrtFile(const std::string& path);
 // Parses text as if it were the file `path` (for tests and fuzzing).
-ImportResult importPbrtText(const std::string& text, const std::string& path);
+// `maxTriangles` (0: scene::limits::kMaxPbrtTriangles) lets a test reach
+// the triangle budget with a small scene.
+ImportResult importPbrtText(const std::string& text, const std::string& path, uint64_t maxTriangles = 0);
 
 // True when the scene file should be read as pbrt (by extension, .pbrt).
 bool isPbrtPath(const std::string& path);

@@ -16,6 +16,7 @@
 #include "import/pbrt_math.h"
 #include "import/pbrt_params.h"
 #include "import/pbrt_tokenizer.h"
+#include "scene/limits.h"
 
 namespace tdpm::pbrt::detail {
 
@@ -104,6 +105,7 @@ class Importer {
   void start() { memoryAtStart_ = availableMemoryBytes(); }
   void finish(const std::string& file);
   std::string mainDir;  // pbrt's search directory: the main scene file's
+  uint64_t maxTriangles = scene::limits::kMaxPbrtTriangles;
 
  private:
   // statements
@@ -136,7 +138,7 @@ class Importer {
   void requireOptions(const Loc& at, const std::string& stmt) const;
   void mapPixelFilter(scene::RenderSettings& r, bool v4Film);
   void checkNesting(const Loc& at, const std::string& stmt) const;
-  void countTriangles(uint64_t n, const Loc& at, const std::string& what);
+  void countTriangles(uint64_t n, const Loc& at, const std::string& what, bool add = true);
 
   GraphicsState gs_;
   std::vector<StackEntry> stack_;

@@ -272,10 +272,10 @@ void Importer::lightSource(const std::string& type, const ParamSet& ps, const Lo
     double cosT = std::cos(cone * kPiD / 180), cosS = std::cos((cone - delta) * kPiD / 180);
     if (power > 0) I = I * float(power / (2 * kPiD * ((1 - cosS) + (cosS - cosT) / 2)));  // pbrt-v4's k_e
     Vec3f from = ps.getPoint("from", {0, 0, 0}), to = ps.getPoint("to", {0, 0, 1});
-    Vec3f dir = M.vector(to - from);
-    if (!(length(dir) > 0)) failAt(at, "LightSource \"spot\": from and to coincide");
     std::string degenerate = scaleProblem(M);
     if (!degenerate.empty()) failAt(at, "LightSource \"spot\": its transform is unusable: " + degenerate);
+    Vec3f dir = M.vector(to - from);
+    if (!(length(dir) > 0)) failAt(at, "LightSource \"spot\": from and to coincide");
     std::optional<Pose> p = decompose(M);
     if (!p || std::fabs(std::fabs(p->scale.x) - std::fabs(p->scale.y)) > 1e-5f * std::fabs(p->scale.x) ||
         std::fabs(std::fabs(p->scale.x) - std::fabs(p->scale.z)) > 1e-5f * std::fabs(p->scale.x))
