@@ -21,7 +21,9 @@
 #include "image/image_header.h"
 #include "import/pbrt_import.h"
 #include "import/ply_reader.h"
+#include "scene/json_writer.h"
 #include "scene/limits.h"
+#include "scene/parse.h"
 
 using namespace tdpm;
 
@@ -313,4 +315,104 @@ TEST_CASE("compare: --csv that is a link to an input image is refused (file iden
   c = test::runTdpm("compare '" + dir + "/a.pfm' '" + dir + "/b.pfm' --profile-row 0 --csv '" + dir + "/./a.pfm'");
   CHECK(c.exitCode == 1);
   CHECK(contains(c.output, "is the input image"));
+}
+
+// ---------------------------------------------------------------- issue 23 item 10: small exact mappings
+
+TEST_CASE("pbrt convert: a spot light survives the JSON bit for bit (direction, cone, falloff, power)") {
+  // caustic-glass's spot light: from (0 5 9) to (-5 2.75 0), a bright RGB I.
+  pbrt::ImportResult r = pbrt::importPbrtText(
+      "Film \"image\" \"integer xresolution\" 8 \"integer yresolution\" 6\nWorldBegin\n"
+      "LightSource \"spot\" \"point from\" [0 5 9] \"point to\" [-5 2.75 0] \"float coneangle\" 30 "
+      "\"float conedeltaangle\" 5 \"rgb I\" [139.8113403320 118.6366500854 105.3887557983]\nShape \"sphere\"\n",
+      "dir/q.pbrt");
+  REQUIRE(r.scene.lights.size() == 1);
+  pbrt::SceneJson js = pbrt::sceneToJson(r.scene, "dir/q.json");
+  scene::SceneDescription back = scene::parseScene(js.json, "dir/q.json");
+  REQUIRE(back.lights.size() == 1);
+  const scene::LightDesc &a = r.scene.lights[0], &b = back.lights[0];
+  CHECK(a.direction.x == b.direction.x);
+  CHECK(a.direction.y == b.direction.y);
+  CHECK(a.direction.z == b.direction.z);
+  CHECK(a.position.x == b.position.x);
+  CHECK(a.coneAngle == b.coneAngle);
+  CHECK(a.falloffStart == b.falloffStart);
+  CHECK(a.power.r == b.power.r);
+  CHECK(a.power.g == b.power.g);
+  CHECK(a.power.b == b.power.b);
+}
+
+namespace {
+bool hasNote(const pbrt::ImportResult& r, const std::string& part) {
+  for (const std::string& n : r.notes)
+    if (contains(n, part)) return true;
+  return false;
+}
+int countNotes(const pbrt::ImportResult& r, const std::string& part) {
+  int k = 0;
+  for (const std::string& n : r.notes) k += contains(n, part);
+  return k;
+}
+const std::string kQuadLight =
+    "AttributeBegin\nAreaLightSource \"%s\" \"rgb L\" [2 2 2]%s\n"
+    "Shape \"trianglemesh\" \"point P\" [-1 0 -1 1 0 -1 1 0 1 -1 0 1] \"integer indices\" [0 1 2 0 2 3]\nAttributeEnd\n";
+std::string quadLight(const std::string& type, const std::string& extra = "") {
+  std::string s = kQuadLight;
+  s.replace(s.find("%s"), 2, type);
+  s.replace(s.find("%s"), 2, extra);
+  return s;
+}
+}  // namespace
+
+TEST_CASE("pbrt-v3 Film \"image\" \"float scale\" scales every light (linear transport: exact)") {
+  std::string world = "WorldBegin\nLightSource \"point\" \"rgb I\" [1 2 3]\nLightSource \"infinite\" \"rgb L\" [0.5 0.5 0.5]\n";
+  pbrt::ImportResult one = pbrt::importPbrtText("Film \"image\"\n" + world, "dir/q.pbrt");
+  pbrt::ImportResult four = pbrt::importPbrtText("Film \"image\" \"float scale\" 4\n" + world, "dir/q.pbrt");
+  REQUIRE(four.scene.lights.size() == 1);
+  CHECK(four.scene.lights[0].power.g == 4 * one.scene.lights[0].power.g);
+  CHECK(four.scene.background.r == 2.0f);
+  CHECK(hasNote(four, "dir/q.pbrt:1: Film: pbrt-v3's Film \"image\" scales the image by \"scale\" = 4; the import scales every light by it"));
+  CHECK(contains(errorOf("Film \"image\" \"float scale\" 0\nWorldBegin\n"), "dir/q.pbrt:1: Film \"image\": parameter \"float scale\": must be positive"));
+}
+
+TEST_CASE("pbrt-v3 AreaLightSource \"area\" is the diffuse area light") {
+  scene::SceneDescription a = pbrt::importPbrtText("WorldBegin\n" + quadLight("area"), "dir/q.pbrt").scene;
+  scene::SceneDescription d = pbrt::importPbrtText("WorldBegin\n" + quadLight("diffuse"), "dir/q.pbrt").scene;
+  REQUIRE(a.lights.size() == 1);
+  REQUIRE(d.lights.size() == 1);
+  CHECK(a.lights[0].power.r == d.lights[0].power.r);
+  CHECK(a.lights[0].areaSize.x == d.lights[0].areaSize.x);
+  CHECK(contains(errorOf("WorldBegin\n" + quadLight("goniometric")), "(only \"diffuse\", or pbrt-v3's alias \"area\")"));
+}
+
+TEST_CASE("pbrt: light sample counts are ignored with a note, not an error") {
+  pbrt::ImportResult r = pbrt::importPbrtText("WorldBegin\n" + quadLight("diffuse", " \"integer nsamples\" 4") +
+                                                  "LightSource \"infinite\" \"integer nsamples\" 8\n",
+                                              "dir/q.pbrt");
+  CHECK(hasNote(r, "dir/q.pbrt:3: AreaLightSource: \"nsamples\" ignored (quality only"));
+  CHECK(hasNote(r, "dir/q.pbrt:6: LightSource \"infinite\": \"nsamples\" ignored (quality only"));
+}
+
+TEST_CASE("pbrt: the spot falloff note is for pbrt-v4 files only (the quartic is pbrt-v3's own curve)") {
+  std::string world = "WorldBegin\nLightSource \"spot\" \"float coneangle\" 30 \"float conedeltaangle\" 5\n";
+  CHECK(!hasNote(pbrt::importPbrtText("Film \"image\"\n" + world, "dir/q.pbrt"), "smoothstep"));
+  CHECK(hasNote(pbrt::importPbrtText("Film \"rgb\"\n" + world, "dir/q.pbrt"), "smoothstep"));
+}
+
+TEST_CASE("pbrt: one note for a PLY's normal (nx, ny, nz), not three") {
+  std::string dir = test::makeTempDir();
+  test::writeFile(dir + "/n.ply",
+                  "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                  "property float nx\nproperty float ny\nproperty float nz\n"
+                  "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n");
+  test::writeFile(dir + "/s.pbrt", "WorldBegin\nShape \"plymesh\" \"string filename\" \"n.ply\"\n");
+  pbrt::ImportResult r = pbrt::importPbrtFile(dir + "/s.pbrt");
+  CHECK(countNotes(r, "plymesh") == 1);
+  CHECK(hasNote(r, "Shape \"plymesh\": vertex properties \"nx\", \"ny\", \"nz\" ignored"));
+}
+
+TEST_CASE("pbrt: texture errors name every supported kind and type") {
+  CHECK(contains(errorOf("WorldBegin\nTexture \"t\" \"bogus\" \"constant\"\n"), "(float, spectrum, or pbrt-v3's color/rgb)"));
+  CHECK(contains(errorOf("WorldBegin\nTexture \"t\" \"spectrum\" \"imagemap\"\n"),
+                 "type \"imagemap\" is not supported (supported: constant, and checkerboard as a reflectance)"));
 }

@@ -412,7 +412,9 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
     requireWorld(at, s);
     std::string type = c.string(s);
     ParamSet ps = c.params("AreaLightSource \"" + type + "\"");
-    if (type != "diffuse") failAt(at, "AreaLightSource \"" + type + "\" is not supported (only \"diffuse\")");
+    // pbrt-v3 also accepts "area" for its (only) diffuse area light.
+    if (type != "diffuse" && type != "area")
+      failAt(at, "AreaLightSource \"" + type + "\" is not supported (only \"diffuse\", or pbrt-v3's alias \"area\")");
     gs_.area = AreaLight{std::move(ps), at};
   } else if (s == "ObjectBegin") {
     requireWorld(at, s);
@@ -493,6 +495,13 @@ void Importer::worldBegin(const Loc& at) {
       if (ps.getFloat("whitebalance", 0) != 0) ps.fail(*ps.find("whitebalance"), "white balancing is not supported");
       if (ps.getString("sensor", "cie1931") != "cie1931") ps.fail(*ps.find("sensor"), "only the cie1931 sensor is supported");
       imagingRatio_ = iso / 100.0;  // times the exposure time, below
+    } else if (ps.has("scale")) {
+      // pbrt-v3's image film multiplies every pixel by "scale": exact as a
+      // factor on every light (light transport is linear).
+      double scale = ps.getFloat("scale", 1);
+      if (!(scale > 0)) ps.fail(*ps.find("scale"), "must be positive, got " + fmtNum(scale));
+      imagingRatio_ = scale;
+      filmFactorWhat_ = "pbrt-v3's Film \"image\" scales the image by \"scale\"";
     }
     ps.checkAllUsed();
   }
@@ -654,16 +663,16 @@ void Importer::finish(const std::string& file) {
     for (auto& l : result.scene.lights) {
       l.power = l.power * k;
       if (!std::isfinite(l.power.r) || !std::isfinite(l.power.g) || !std::isfinite(l.power.b))
-        failAt(film_.at, "Film: pbrt-v4 scales the image by exposure time x ISO / 100 = " + fmtNum(imagingRatio_) + ", which makes " +
+        failAt(film_.at, "Film: " + filmFactorWhat_ + " = " + fmtNum(imagingRatio_) + ", which makes " +
                              l.name + " infinitely bright (its power overflows a float)");
     }
     if (!result.scene.background.isBlack()) result.scene.background = result.scene.background * k;
     if (!std::isfinite(result.scene.background.r) || !std::isfinite(result.scene.background.g) ||
         !std::isfinite(result.scene.background.b))
-      failAt(film_.at, "Film: pbrt-v4 scales the image by exposure time x ISO / 100 = " + fmtNum(imagingRatio_) +
+      failAt(film_.at, "Film: " + filmFactorWhat_ + " = " + fmtNum(imagingRatio_) +
                            ", which makes the infinite light's radiance overflow a float");
-    result.notes.push_back(film_.at.str() + ": Film: pbrt-v4 scales the image by exposure time x ISO / 100 = " +
-                           fmtNum(imagingRatio_) + "; the import scales every light by it");
+    result.notes.push_back(film_.at.str() + ": Film: " + filmFactorWhat_ + " = " + fmtNum(imagingRatio_) +
+                           "; the import scales every light by it");
   }
   validateAsJson();
 }

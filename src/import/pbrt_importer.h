@@ -133,6 +133,7 @@ class Importer {
   Rgb color(const ParamSet& ps, const std::string& name, Rgb fallback) const;
   double floatParam(const ParamSet& ps, const std::string& name, double fallback) const;
   Rgb lightScale(const ParamSet& ps) const;
+  void noteLightSamples(const ParamSet& ps, const Loc& at, const std::string& what);
   void note(const Loc& at, const std::string& what);
   void requireWorld(const Loc& at, const std::string& stmt) const;
   void requireOptions(const Loc& at, const std::string& stmt) const;
@@ -172,7 +173,10 @@ class Importer {
   Mat cameraCtm_[2];
   bool mirror_ = true;
   float shutterOpen_ = 0, shutterClose_ = 1;
-  double imagingRatio_ = 1;  // pbrt-v4 film: exposure time * ISO / 100
+  double imagingRatio_ = 1;  // pbrt-v4 film: exposure time * ISO / 100; pbrt-v3 image film: "scale"
+  std::string filmFactorWhat_ = "pbrt-v4 scales the image by exposure time x ISO / 100";
+  // pbrt-v3 syntax (Film "image"): notes about pbrt-v4-only behaviour are left out.
+  bool pbrtV3() const { return film_.given && film_.type == "image"; }
   Loc worldAt_;
 
   static MaterialSlot defaultMaterial() {

@@ -64,7 +64,7 @@ void Importer::texture(const std::string& name, const std::string& kind, const s
                        const Loc& at) {
   bool isFloat = kind == "float";
   if (!isFloat && kind != "spectrum" && kind != "color" && kind != "rgb")
-    failAt(at, "Texture \"" + name + "\": unknown texture kind \"" + kind + "\" (float or spectrum)");
+    failAt(at, "Texture \"" + name + "\": unknown texture kind \"" + kind + "\" (float, spectrum, or pbrt-v3's color/rgb)");
   TextureValue t;
   t.isFloat = isFloat;
   if (type == "constant") {
@@ -87,7 +87,7 @@ void Importer::texture(const std::string& name, const std::string& kind, const s
     note(at, "Texture \"" + name + "\": the checkerboard's antialiasing filter is not applied (tdpm supersamples instead)");
     t.checker = c;
   } else {
-    failAt(at, "Texture \"" + name + "\": type \"" + type + "\" is not supported (constant)");
+    failAt(at, "Texture \"" + name + "\": type \"" + type + "\" is not supported (supported: constant, and checkerboard as a reflectance)");
   }
   ps.checkAllUsed();
   textures_[name] = t;
@@ -235,6 +235,15 @@ uint32_t Importer::materialIndex(int slot) {
 
 // ------------------------------------------------------------ lights
 
+// pbrt's light sample counts only change noise: ignored, with one note.
+void Importer::noteLightSamples(const ParamSet& ps, const Loc& at, const std::string& what) {
+  for (const char* q : {"nsamples", "samples"})
+    if (ps.has(q)) {
+      ps.markUsed(q);
+      note(at, what + ": \"" + q + "\" ignored (quality only: tdpm chooses its own light samples)");
+    }
+}
+
 Rgb Importer::lightScale(const ParamSet& ps) const {
   const Param* p = ps.find("scale");
   if (!p) return Rgb(1.0f);
@@ -256,6 +265,7 @@ void Importer::lightSource(const std::string& type, const ParamSet& ps, const Lo
     note(at, "LightSource: lights do not move in pbrt; the StartTime transform is used (as pbrt does)");
   Rgb sc = lightScale(ps);
   double power = ps.has("power") ? ps.getFloat("power", -1) : -1;
+  noteLightSamples(ps, at, "LightSource \"" + type + "\"");
   scene::LightDesc l;
   l.name = "LightSource \"" + type + "\" (" + at.str() + ")";
   if (type == "point") {
@@ -287,7 +297,8 @@ void Importer::lightSource(const std::string& type, const ParamSet& ps, const Lo
     l.falloffStart = float(cone - delta);
     float solid = float(2 * kPiD * ((1 - cosS) + (cosS - cosT) / 5));  // tdpm's exact integral of the quartic falloff
     l.power = I * solid;
-    if (delta > 0)
+    // Exact for pbrt-v3 (Film "image"); a pbrt-v4 or unmarked file is told.
+    if (delta > 0 && !pbrtV3())
       note(at, "LightSource \"spot\": the falloff band uses pbrt-v3's quartic curve; pbrt-v4 uses smoothstep there");
   } else if (type == "distant") {
     if (power > 0) failAt(at, "LightSource \"distant\": \"power\" depends on pbrt's scene radius; give L instead");
@@ -302,7 +313,6 @@ void Importer::lightSource(const std::string& type, const ParamSet& ps, const Lo
     if (ps.has("filename") || ps.has("mapname")) failAt(at, "LightSource \"infinite\": an environment map is not supported (constant L only)");
     if (power > 0 || ps.has("illuminance")) failAt(at, "LightSource \"infinite\": \"power\"/\"illuminance\" is not supported; give L");
     Rgb L = nonNegative(ps, "L", color(ps, "L", Rgb(1.0f))) * sc;
-    for (const char* q : {"nsamples", "samples"}) ps.markUsed(q);
     ps.checkAllUsed();
     result.scene.background = result.scene.background + L;
     backgroundAt_ = at;
@@ -445,8 +455,13 @@ static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(co
     } catch (const Error& e) {
       failAt(rec.at, std::string("Shape \"plymesh\": ") + e.what());
     }
-    for (const std::string& q : ply.ignoredProperties)
-      note("Shape \"plymesh\": vertex property \"" + q + "\" ignored (tdpm shades with the geometric normal)");
+    // One note for all of them (nx, ny, nz is one normal, not three notes).
+    if (!ply.ignoredProperties.empty()) {
+      std::string list;
+      for (const std::string& q : ply.ignoredProperties) list += (list.empty() ? "\"" : ", \"") + q + "\"";
+      note(std::string("Shape \"plymesh\": vertex ") + (ply.ignoredProperties.size() > 1 ? "properties " : "property ") + list +
+           " ignored (tdpm shades with the geometric normal)");
+    }
     g.vertices = std::move(ply.vertices);
     g.indices = std::move(ply.triangles);
     addQuads(g.vertices, ply.quads, rec.at, "Shape \"plymesh\" \"" + file + "\"", &g.indices);
@@ -695,6 +710,7 @@ void Importer::emitAreaLight(const ShapeRecord& rec, const std::vector<Vec3f>& v
   double power = ps.has("power") ? ps.getFloat("power", -1) : -1;
   if (power > 0) L = L * float(power / (kPiD * rectArea));  // pbrt-v4: one side, area A
   if (ps.has("filename")) failAt(rec.area->at, "AreaLightSource: an image emitter (filename) is not supported");
+  noteLightSamples(ps, rec.area->at, "AreaLightSource");
   ps.checkAllUsed();
   scene::LightDesc l;
   l.type = scene::LightDesc::Type::Area;
