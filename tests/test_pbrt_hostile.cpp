@@ -416,3 +416,16 @@ TEST_CASE("pbrt: texture errors name every supported kind and type") {
   CHECK(contains(errorOf("WorldBegin\nTexture \"t\" \"spectrum\" \"imagemap\"\n"),
                  "type \"imagemap\" is not supported (supported: constant, and checkerboard as a reflectance)"));
 }
+
+TEST_CASE("pbrt: options errors are reported in file order (the first wrong statement, not the first mapped)") {
+  // Film is mapped before Camera and Integrator (their values depend on
+  // it), but the error named is the first in the file.
+  CHECK(errorOf("Integrator \"bdpt\"\nCamera \"orthographic\"\nFilm \"bogus\"\nWorldBegin\n") ==
+        "dir/q.pbrt:1: Integrator \"bdpt\" is not supported (path, volpath, sppm)");
+  CHECK(errorOf("Camera \"orthographic\"\nFilm \"bogus\"\nWorldBegin\n") ==
+        "dir/q.pbrt:1: Camera \"orthographic\" is not supported (only perspective)");
+  CHECK(errorOf("Film \"bogus\"\nCamera \"orthographic\"\nWorldBegin\n") ==
+        "dir/q.pbrt:1: Film \"bogus\" is not supported (image, rgb, gbuffer, spectral)");
+  CHECK(errorOf("Sampler \"bogus\"\nPixelFilter \"box\" \"float xradius\" 100\nWorldBegin\n") ==
+        "dir/q.pbrt:1: Sampler \"bogus\" is not supported");
+}

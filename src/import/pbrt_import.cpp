@@ -14,6 +14,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "core/error.h"
@@ -264,6 +265,7 @@ void Importer::parseText(const std::string& text, const std::string& file, int d
     const Token& word = c.next();
     if (word.kind != Token::Kind::Word)
       failAt({file, word.line}, "expected a statement (such as Shape or WorldBegin), got '" + word.text + "'");
+    ++statementCount_;
     try {
       statement(c, word, depth);
     } catch (const std::bad_alloc&) {
@@ -330,7 +332,7 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
   } else if (s == "Camera") {
     requireOptions(at, s);
     std::string type = c.string(s);
-    camera_ = {type, c.params("Camera \"" + type + "\""), at, true};
+    camera_ = {type, c.params("Camera \"" + type + "\""), at, true, statementCount_};
     cameraCtm_[0] = gs_.ctm[0];
     cameraCtm_[1] = gs_.ctm[1];
     for (int i = 0; i < 2; ++i) {
@@ -341,7 +343,7 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
   } else if (s == "Film" || s == "Sampler" || s == "Integrator" || s == "PixelFilter") {
     requireOptions(at, s);
     std::string type = c.string(s);
-    Statement st{type, c.params(s + " \"" + type + "\""), at, true};
+    Statement st{type, c.params(s + " \"" + type + "\""), at, true, statementCount_};
     (s == "Film" ? film_ : s == "Sampler" ? sampler_ : s == "Integrator" ? integrator_ : pixelFilter_) = std::move(st);
   } else if (s == "Accelerator" || s == "ColorSpace") {
     std::string type = c.string(s);
@@ -457,6 +459,32 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
 
 // ------------------------------------------------------------ options block
 
+namespace {
+// The error of the options statement that comes first in the file (by
+// statement number; a statement not given counts as last).
+struct FirstError {
+  int64_t seq = std::numeric_limits<int64_t>::max();
+  std::string what;
+  bool any = false;
+  template <class F>
+  void run(const Statement& st, F&& f) {
+    try {
+      f();
+    } catch (const Error& e) {
+      int64_t s = st.given ? st.seq : std::numeric_limits<int64_t>::max();
+      if (!any || s < seq) {
+        seq = s;
+        what = e.what();
+        any = true;
+      }
+    }
+  }
+  void rethrow() const {
+    if (any) throw Error(what);
+  }
+};
+}  // namespace
+
 static float verticalFov(double fov, int w, int h) {
   // pbrt's fov spans the shorter image axis; tdpm's is vertical.
   if (w >= h) return float(fov);
@@ -470,17 +498,25 @@ void Importer::worldBegin(const Loc& at) {
   scene::SceneDescription& sc = result.scene;
   scene::RenderSettings& r = sc.render;
 
+  // The options statements are mapped here in the order their values
+  // depend on each other (Film, Camera, Sampler, PixelFilter, Integrator).
+  // A failing one is recorded and the others still run, so that the error
+  // reported is the first in the file, as for every other statement.
+  FirstError first;
+
   // Film
   int width = 640, height = 480;
   bool v4Film = false;
+  first.run(film_, [&] {
   if (film_.given) {
     const ParamSet& ps = film_.params;
     if (film_.type == "rgb" || film_.type == "gbuffer" || film_.type == "spectral") v4Film = true;
     else if (film_.type != "image") failAt(film_.at, "Film \"" + film_.type + "\" is not supported (image, rgb, gbuffer, spectral)");
-    width = ps.getInt("xresolution", 640);
-    height = ps.getInt("yresolution", 480);
-    if (width < 1 || height < 1 || width > 65536 || height > 65536)
-      failAt(film_.at, "Film: resolution " + std::to_string(width) + "x" + std::to_string(height) + " is outside 1..65536");
+    int w = ps.getInt("xresolution", 640), h = ps.getInt("yresolution", 480);
+    if (w < 1 || h < 1 || w > 65536 || h > 65536)
+      failAt(film_.at, "Film: resolution " + std::to_string(w) + "x" + std::to_string(h) + " is outside 1..65536");
+    width = w;
+    height = h;
     if (ps.has("filename")) result.filmFilename = ps.getString("filename", "");
     std::vector<double> crop = ps.getFloats("cropwindow");
     if (!crop.empty() && !(crop.size() == 4 && crop[0] == 0 && crop[1] == 1 && crop[2] == 0 && crop[3] == 1))
@@ -505,11 +541,13 @@ void Importer::worldBegin(const Loc& at) {
     }
     ps.checkAllUsed();
   }
+  });
   sc.camera.width = width;
   sc.camera.height = height;
 
   // Camera (pbrt's default: perspective, fov 90, at the origin looking down +z)
   double fov = 90;
+  first.run(camera_, [&] {
   if (camera_.given) {
     const ParamSet& ps = camera_.params;
     if (camera_.type != "perspective") failAt(camera_.at, "Camera \"" + camera_.type + "\" is not supported (only perspective)");
@@ -524,16 +562,20 @@ void Importer::worldBegin(const Loc& at) {
     ps.markUsed("focaldistance");
     ps.checkAllUsed();
   }
+  });
+  first.run(film_, [&] {
   if (v4Film) {
     imagingRatio_ *= double(shutterClose_) - double(shutterOpen_);
     if (!(imagingRatio_ > 0))
       failAt(film_.at, "Film: pbrt-v4 scales the image by exposure time x ISO / 100, which is 0 here (zero-length shutter or iso 0)");
   }
+  });
   sc.camera.shutterOpen = shutterOpen_;
   sc.camera.shutterClose = shutterClose_;
   sc.camera.fovDegrees = verticalFov(fov, width, height);
 
   // The camera frame: camera-to-world C = inverse(CTM at Camera).
+  first.run(camera_, [&] {
   Loc camAt = camera_.given ? camera_.at : at;
   Mat C[2] = {*cameraCtm_[0].inverse(), *cameraCtm_[1].inverse()};
   struct Frame3 { Vec3f pos, fwd, up; };
@@ -584,7 +626,10 @@ void Importer::worldBegin(const Loc& at) {
     }
   }
 
+  });
+
   // Sampler -> spp
+  first.run(sampler_, [&] {
   if (sampler_.given) {
     const ParamSet& ps = sampler_.params;
     static const std::set<std::string> kSamplers = {"halton", "sobol", "zsobol", "paddedsobol", "pmj02bn", "independent",
@@ -607,10 +652,12 @@ void Importer::worldBegin(const Loc& at) {
   } else {
     r.spp = 16;  // pbrt's default pixelsamples
   }
+  });
 
-  mapPixelFilter(r, v4Film);
+  first.run(pixelFilter_, [&] { mapPixelFilter(r, v4Film); });
 
   // Integrator -> method
+  first.run(integrator_, [&] {
   std::string integ = integrator_.given ? integrator_.type : "path";
   const ParamSet& ip = integrator_.params;
   Loc iat = integrator_.given ? integrator_.at : at;
@@ -648,6 +695,8 @@ void Importer::worldBegin(const Loc& at) {
     failAt(iat, "Integrator \"" + integ + "\" is not supported (path, volpath, sppm)");
   }
   if (integrator_.given) ip.checkAllUsed();
+  });
+  first.rethrow();
 
   gs_.ctm[0] = gs_.ctm[1] = Mat();
   coordSystems_["world"] = Mat();

@@ -88,6 +88,7 @@ struct Statement {  // an options-block statement kept until WorldBegin
   ParamSet params;
   Loc at;
   bool given = false;
+  int64_t seq = 0;  // statement number in reading order (errors are reported in file order)
 };
 
 class Cursor;
@@ -157,6 +158,7 @@ class Importer {
   uint64_t bytesRead_ = 0;
   int includes_ = 0;
   uint64_t triangles_ = 0;
+  int64_t statementCount_ = 0;
   uint64_t memoryAtStart_ = 0;  // MemAvailable when the import began (0: unknown)
   std::map<std::string, uint64_t> instanceTriangles_;  // per object, once instanced
 
