@@ -429,3 +429,14 @@ TEST_CASE("pbrt: options errors are reported in file order (the first wrong stat
   CHECK(errorOf("Sampler \"bogus\"\nPixelFilter \"box\" \"float xradius\" 100\nWorldBegin\n") ==
         "dir/q.pbrt:1: Sampler \"bogus\" is not supported");
 }
+
+TEST_CASE("cli: render of a pbrt scene refuses an output that is a file the scene includes") {
+  std::string dir = test::makeTempDir();
+  // A mislabelled include: "out.png" is pbrt text, and would be the preview.
+  test::writeFile(dir + "/out.png", "LightSource \"point\" \"rgb I\" [1 1 1]\n");
+  test::writeFile(dir + "/s.pbrt", "Film \"image\" \"integer xresolution\" 4 \"integer yresolution\" 3\nWorldBegin\nInclude \"out.png\"\nShape \"sphere\"\n");
+  auto r = test::runTdpm("render -q '" + dir + "/s.pbrt' -m pathtrace --spp 1 -o '" + dir + "/out.exr'");
+  CHECK(r.exitCode == 1);
+  CHECK(contains(r.output, "is a file the scene reads '" + dir + "/out.png'; writing it would destroy an input"));
+  CHECK(!test::fileExists(dir + "/out.exr"));
+}

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <cstdio>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -418,6 +419,10 @@ int runRender(const RenderArgs& a) {
       preview = image::previewPathFor(output);
       if (comm.root()) validateOutput(output, preview, a.scene);
     }
+    // An Include or PLY mesh named like the output is an input too.
+    if (comm.root() && !framePattern)
+      for (const std::string& f : std::set<std::string>(imported.inputFiles.begin(), imported.inputFiles.end()))
+        refuseOverwritingInput(output, preview, f, "a file the scene reads");
     desc = std::move(imported.scene);
     settingSources = std::move(imported.settingSources);
   } else {

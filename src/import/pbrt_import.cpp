@@ -259,7 +259,12 @@ void Importer::applyTransform(const Mat& m, bool replace) {
 }
 
 void Importer::parseText(const std::string& text, const std::string& file, int depth) {
-  std::vector<Token> tokens = tokenize(text, file);
+  std::vector<Token> tokens;
+  try {
+    tokens = tokenize(text, file);
+  } catch (const std::bad_alloc&) {
+    throw Error(file + ": out of memory while reading its " + std::to_string(text.size()) + " bytes");
+  }
   Cursor c(tokens, file);
   while (!c.done()) {
     const Token& word = c.next();
