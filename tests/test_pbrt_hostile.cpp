@@ -114,9 +114,23 @@ TEST_CASE("pbrt budgets: instanced triangles are counted before each copy is mad
   pbrt::ImportResult ok = pbrt::importPbrtText(text, "dir/q.pbrt", 1000);
   CHECK(ok.scene.objects.size() == 10);
   text += "ObjectInstance \"strip\"\n";  // line 15: the 11th copy
+  // The copies still to come in the file are counted at the first one
+  // (line 5), once its size is known: 10 more copies are not built first.
   std::string e = test::errorMessageOf([&] { pbrt::importPbrtText(text, "dir/q.pbrt", 1000); });
-  CHECK(e == "dir/q.pbrt:15: ObjectInstance \"strip\": the scene would have 1100 triangles, more than tdpm's limit of 1000 "
-             "(instanced copies count in full)");
+  CHECK(e == "dir/q.pbrt:5: ObjectInstance \"strip\" (its 10 later copies in this file): the scene would have 1100 triangles, "
+             "more than tdpm's limit of 1000 (instanced copies count in full)");
+  // An included file's copies are counted with that file's own later ones.
+  std::string dir = test::makeTempDir();
+  std::string more;
+  for (int i = 0; i < 5; ++i) more += "ObjectInstance \"strip\"\n";
+  test::writeFile(dir + "/more.pbrt", more);
+  std::string head = text.substr(0, text.find("ObjectInstance"));
+  std::string main = head;
+  for (int i = 0; i < 6; ++i) main += "ObjectInstance \"strip\"\n";
+  main += "Include \"more.pbrt\"\n";
+  e = test::errorMessageOf([&] { pbrt::importPbrtText(main, dir + "/q.pbrt", 1000); });
+  CHECK(e == dir + "/more.pbrt:1: ObjectInstance \"strip\" (with its 4 later copies in this file): the scene would have 1100 "
+                   "triangles, more than tdpm's limit of 1000 (instanced copies count in full)");
   // Without instancing, the shape itself is counted at its line.
   e = test::errorMessageOf([&] {
     pbrt::importPbrtText("WorldBegin\nShape \"trianglemesh\" \"point P\" [" + P + "] \"integer indices\" [" + idx + "]\n",

@@ -265,6 +265,14 @@ void Importer::parseText(const std::string& text, const std::string& file, int d
   } catch (const std::bad_alloc&) {
     throw Error(file + ": out of memory while reading its " + std::to_string(text.size()) + " bytes");
   }
+  // The ObjectInstance statements still to come in this file, per object:
+  // the triangle pre-flight counts them all at the first copy whose size
+  // is known, instead of building copies until the budget runs out.
+  std::map<std::string, uint64_t> pending;
+  for (size_t i = 0; i + 1 < tokens.size(); ++i)
+    if (tokens[i].kind == Token::Kind::Word && tokens[i].text == "ObjectInstance" && tokens[i + 1].kind == Token::Kind::String)
+      ++pending[tokens[i + 1].text];
+  pendingInstances_.push_back(std::move(pending));
   Cursor c(tokens, file);
   while (!c.done()) {
     const Token& word = c.next();
@@ -279,6 +287,7 @@ void Importer::parseText(const std::string& text, const std::string& file, int d
       failAt({file, word.line}, word.text + ": out of memory while importing this statement");
     }
   }
+  pendingInstances_.pop_back();
 }
 
 static Mat matrixFrom16(const std::vector<double>& v) {
@@ -446,15 +455,38 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
     auto it = instances_.find(name);
     if (it == instances_.end()) failAt(at, "ObjectInstance: no object named \"" + name + "\" has been defined");
     // Pre-flight: once an object's triangle count is known (its first
-    // instance), every further copy is counted before it is made.
+    // instance), this copy and the later ones in this file are counted
+    // before this one is made.
+    uint64_t later = 0;
+    if (!pendingInstances_.empty()) {
+      uint64_t& p = pendingInstances_.back()[name];
+      if (p > 0) --p;
+      later = p;
+    }
+    auto preflight = [&](uint64_t perCopy) {
+      if (perCopy == 0) return;
+      uint64_t copies = std::min<uint64_t>(later, (uint64_t(1) << 62) / perCopy);
+      countTriangles(perCopy * (1 + copies), at,
+                     "ObjectInstance \"" + name + "\"" + (copies ? " (with its " + std::to_string(later) + " later copies in this file)" : ""),
+                     false);
+    };
     auto known = instanceTriangles_.find(name);
-    if (known != instanceTriangles_.end()) countTriangles(known->second, at, "ObjectInstance \"" + name + "\"", false);
+    if (known != instanceTriangles_.end()) preflight(known->second);
     uint64_t before = triangles_;
     for (const ShapeRecord& rec : it->second) {
       Mat ctm[2] = {gs_.ctm[0] * rec.ctm[0], gs_.ctm[1] * rec.ctm[1]};
       emitShape(rec, ctm, at);
     }
-    if (known == instanceTriangles_.end()) instanceTriangles_[name] = triangles_ - before;
+    if (known == instanceTriangles_.end()) {
+      instanceTriangles_[name] = triangles_ - before;
+      // The copies still to come, counted now that one copy's size is known.
+      uint64_t perCopy = triangles_ - before;
+      if (perCopy > 0 && later > 0) {
+        uint64_t copies = std::min<uint64_t>(later, (uint64_t(1) << 62) / perCopy);
+        countTriangles(perCopy * copies, at,
+                       "ObjectInstance \"" + name + "\" (its " + std::to_string(later) + " later copies in this file)", false);
+      }
+    }
   } else if (s == "ReverseOrientation") {
     failAt(at, "ReverseOrientation is not supported (tdpm cannot flip a sphere's or an emitter's orientation)");
   } else {

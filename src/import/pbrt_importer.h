@@ -161,6 +161,7 @@ class Importer {
   int64_t statementCount_ = 0;
   uint64_t memoryAtStart_ = 0;  // MemAvailable when the import began (0: unknown)
   std::map<std::string, uint64_t> instanceTriangles_;  // per object, once instanced
+  std::vector<std::map<std::string, uint64_t>> pendingInstances_;  // per file being read: ObjectInstance statements to come
 
   // Where each scene.objects[i] / scene.lights[i] / the background came
   // from, to name the pbrt statement when the JSON checks refuse it.
