@@ -17,6 +17,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "image/image_header.h"
 #include "image/read_image.h"
 #include "image/metrics.h"
 #include "image/profile_plot.h"
@@ -207,13 +208,36 @@ int runCompare(const CompareArgs& a) {
   // Outputs first: a wrong path must not cost reading two large EXRs, and
   // nothing is written unless everything below succeeds.
   if (a.plot && !endsWith(*a.plot, ".svg")) throw Error("--plot: '" + *a.plot + "' must end in .svg (it is an SVG file)");
-  if (a.csv && a.plot && *a.csv == *a.plot) throw Error("--csv and --plot name the same file '" + *a.csv + "'");
+  // By file identity (st_dev/st_ino), not by name: a link to an input, or
+  // another spelling of its path, would overwrite it just the same.
+  auto same = [](const std::string& x, const std::string& y) { return x == y || sameFile(x, y); };
+  if (a.csv && a.plot && same(*a.csv, *a.plot)) throw Error("--csv and --plot name the same file '" + *a.csv + "'");
   for (const auto& [flag, out] : {std::pair{"--csv", a.csv}, std::pair{"--plot", a.plot}}) {
     if (!out) continue;
-    if (*out == a.test || *out == a.reference)
-      throw Error(std::string(flag) + ": '" + *out + "' is one of the input images; refusing to overwrite it");
+    for (const std::string* in : {&a.test, &a.reference})
+      if (same(*out, *in))
+        throw Error(std::string(flag) + ": '" + *out + "' is the input image '" + *in + "'" +
+                    (*out == *in ? "" : " (the same file)") + "; refusing to overwrite it");
     checkWritable(flag, *out);
   }
+
+  // Sizes from the headers before either image is decoded (a small PNG can
+  // claim 20000x20000). A header too damaged to tell is left to the reader.
+  std::optional<image::ImageHeader> testHeader, refHeader;
+  try {
+    testHeader = image::readImageHeader(a.test);
+  } catch (const Error& e) {
+    throw Error(std::string("test image: ") + e.what());
+  }
+  try {
+    refHeader = image::readImageHeader(a.reference);
+  } catch (const Error& e) {
+    throw Error(std::string("reference image: ") + e.what());
+  }
+  if (testHeader && refHeader && (testHeader->width != refHeader->width || testHeader->height != refHeader->height))
+    throw Error("image sizes differ: " + a.test + " is " + std::to_string(testHeader->width) + "x" +
+                std::to_string(testHeader->height) + " but " + a.reference + " is " + std::to_string(refHeader->width) + "x" +
+                std::to_string(refHeader->height) + " (compare needs two images of the same size; read from their headers)");
 
   // The readers' errors already name the file ("<path>: ..."); say which role.
   image::LoadedImage test, ref;

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <cstdio>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -411,6 +412,7 @@ int runRender(const RenderArgs& a) {
   // A frame pattern (out/frame_####.exr) is checked once the frames are known.
   if (comm.root() && (!pbrtScene || !a.output.empty()) && !framePattern) validateOutput(output, preview, a.scene);
 
+  std::map<std::string, std::string> settingSources;  // pbrt: where derived render settings came from
   if (pbrtScene) {
     pbrt::ImportResult imported = pbrt::importPbrtFile(a.scene);
     if (comm.root())
@@ -420,7 +422,12 @@ int runRender(const RenderArgs& a) {
       preview = image::previewPathFor(output);
       if (comm.root()) validateOutput(output, preview, a.scene);
     }
+    // An Include or PLY mesh named like the output is an input too.
+    if (comm.root() && !framePattern)
+      for (const std::string& f : std::set<std::string>(imported.inputFiles.begin(), imported.inputFiles.end()))
+        refuseOverwritingInput(output, preview, f, "a file the scene reads");
     desc = std::move(imported.scene);
+    settingSources = std::move(imported.settingSources);
   } else {
     desc = scene::loadScene(a.scene);
   }
@@ -444,6 +451,8 @@ int runRender(const RenderArgs& a) {
       if (o.shape.type == scene::ShapeDesc::Type::Mesh)
         refuseOverwritingInput(output, preview, o.shape.meshFile, "the mesh file of object '" + o.name + "'");
   opt = mergeOptions(a, desc.render, a.scene);
+  // A pbrt scene's photon count comes from a statement, not a JSON key.
+  if (!a.photons && settingSources.count("photons")) opt.causticPhotonsSource = settingSources["photons"];
   // Passes by default where they are available: not for an animation's frames.
   mergeProgressiveOptions(a, desc.render, a.scene, opt, !desc.animation, comm.root());
   checkResumeFlags(a.resume ? &*a.resume : nullptr, opt.progressive);

@@ -1,5 +1,5 @@
 // core/regular_file.h — open an input file only if it is a regular file.
-// Owns: openRegularInput, the one way tdpm opens a file it reads by name
+// Owns: openRegularInput (and checkRegularFile, its stat()-only form), the one way tdpm opens a file it reads by name
 // when a FIFO, a device or a socket must not be read (issue 27 item 6).
 // Why: stat() then open() still blocks for ever when the name is a FIFO
 // with no writer (open(O_RDONLY) waits for one), and a device such as
@@ -26,5 +26,18 @@ std::FILE* openRegularInput(const std::string& path, const std::string& what, ui
 // The same check without keeping the file open (it is opened and closed):
 // for readers that open the file by name themselves (OpenEXR).
 void requireRegularInput(const std::string& path, const std::string& what);
+
+// The answer of stat() alone, for readers that open the file themselves
+// (std::ifstream: pbrt Include, PLY) and want its size for a budget first.
+// stat() follows symlinks and never blocks; a name swapped for a FIFO
+// between this check and the open is not caught (openRegularInput is).
+struct RegularFileCheck {
+  bool ok = false;
+  uint64_t size = 0;   // bytes, when ok
+  std::string problem;  // when not ok: "it does not exist", "it is a directory", "it is a FIFO (named pipe)", ...
+};
+
+// stat()s `path` (following symlinks) without opening it.
+RegularFileCheck checkRegularFile(const std::string& path);
 
 }  // namespace tdpm

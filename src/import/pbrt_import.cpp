@@ -14,9 +14,12 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "core/error.h"
+#include "core/memory.h"
+#include "core/regular_file.h"
 #include "import/pbrt_importer.h"
 #include "sampling/filter.h"
 #include "scene/limits.h"
@@ -36,17 +39,31 @@ std::string fmtNum(double v) {
   return s.str();
 }
 
-std::string readWholeFile(const std::string& path, const std::string& where) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw Error(where + path + ": cannot read scene file: it is a directory");
+void Importer::parseFile(const std::string& path, int depth, const std::string& where) {
+  namespace L = scene::limits;
+  RegularFileCheck f = checkRegularFile(path);
+  if (!f.ok) throw Error(where + path + ": cannot read scene file: " + f.problem);
+  if (f.size > L::kMaxPbrtFileBytes)
+    throw Error(where + path + ": pbrt file is too large (" + std::to_string(f.size) + " bytes; at most " +
+                std::to_string(L::kMaxPbrtFileBytes >> 20) + " MiB per file; put large meshes in PLY files)");
+  if (f.size > L::kMaxPbrtTotalBytes - bytesRead_)
+    throw Error(where + path + ": the scene's files together are larger than " + std::to_string(L::kMaxPbrtTotalBytes >> 20) +
+                " MiB (" + std::to_string(bytesRead_) + " bytes read before this " + std::to_string(f.size) +
+                "-byte file; is a file included many times?)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(where + path + ": cannot read scene file (" + std::strerror(errno) + ")");
-  // Not a device or a pipe (Include "/dev/zero" would never end).
-  if (!std::filesystem::is_regular_file(path, ec)) throw Error(where + path + ": cannot read scene file: not a regular file");
-  std::ostringstream text;
-  text << in.rdbuf();
+  // Read at most one chunk over the budget, in case the file grew since the stat.
+  const uint64_t budget = std::min(L::kMaxPbrtFileBytes, L::kMaxPbrtTotalBytes - bytesRead_);
+  std::string text;
+  char chunk[1 << 16];
+  while (in.read(chunk, sizeof chunk), in.gcount() > 0) {
+    text.append(chunk, size_t(in.gcount()));
+    if (text.size() > budget) throw Error(where + path + ": pbrt file grew past its size limit while being read");
+  }
   if (in.bad()) throw Error(where + path + ": error while reading scene file");
-  return text.str();
+  bytesRead_ += text.size();
+  result.inputFiles.push_back(path);
+  parseText(text, path, depth);
 }
 
 // A relative path is looked up beside the file that names it; if it is not
@@ -150,6 +167,28 @@ void Importer::note(const Loc& at, const std::string& what) {
   result.notes.push_back(at.str() + ": " + what);
 }
 
+void Importer::checkNesting(const Loc& at, const std::string& stmt) const {
+  if (stack_.size() >= size_t(scene::limits::kMaxPbrtNesting))
+    failAt(at, stmt + ": AttributeBegin/TransformBegin/ObjectBegin nested more than " +
+                   std::to_string(scene::limits::kMaxPbrtNesting) + " deep");
+}
+
+// Adds n triangles to the scene's count (with !add: only checks), refusing before the copy is made
+// when the count passes kMaxPbrtTriangles or its estimated memory the
+// memory available when the import began.
+void Importer::countTriangles(uint64_t n, const Loc& at, const std::string& what, bool add) {
+  namespace L = scene::limits;
+  uint64_t total = triangles_ + n;
+  if (total > maxTriangles)
+    failAt(at, what + ": the scene would have " + std::to_string(total) + " triangles, more than tdpm's limit of " +
+                   std::to_string(maxTriangles) + " (instanced copies count in full)");
+  if (memoryAtStart_ > 0 && total * L::kPbrtBytesPerTriangle > memoryAtStart_)
+    failAt(at, what + ": the scene would have " + std::to_string(total) + " triangles, about " +
+                   std::to_string((total * L::kPbrtBytesPerTriangle) >> 20) + " MiB, more than the " +
+                   std::to_string(memoryAtStart_ >> 20) + " MiB of memory available");
+  if (add) triangles_ = total;
+}
+
 void Importer::requireWorld(const Loc& at, const std::string& stmt) const {
   if (!inWorld_) failAt(at, stmt + " is only allowed after WorldBegin");
 }
@@ -220,14 +259,35 @@ void Importer::applyTransform(const Mat& m, bool replace) {
 }
 
 void Importer::parseText(const std::string& text, const std::string& file, int depth) {
-  std::vector<Token> tokens = tokenize(text, file);
+  std::vector<Token> tokens;
+  try {
+    tokens = tokenize(text, file);
+  } catch (const std::bad_alloc&) {
+    throw Error(file + ": out of memory while reading its " + std::to_string(text.size()) + " bytes");
+  }
+  // The ObjectInstance statements still to come in this file, per object:
+  // the triangle pre-flight counts them all at the first copy whose size
+  // is known, instead of building copies until the budget runs out.
+  std::map<std::string, uint64_t> pending;
+  for (size_t i = 0; i + 1 < tokens.size(); ++i)
+    if (tokens[i].kind == Token::Kind::Word && tokens[i].text == "ObjectInstance" && tokens[i + 1].kind == Token::Kind::String)
+      ++pending[tokens[i + 1].text];
+  pendingInstances_.push_back(std::move(pending));
   Cursor c(tokens, file);
   while (!c.done()) {
     const Token& word = c.next();
     if (word.kind != Token::Kind::Word)
       failAt({file, word.line}, "expected a statement (such as Shape or WorldBegin), got '" + word.text + "'");
-    statement(c, word, depth);
+    ++statementCount_;
+    try {
+      statement(c, word, depth);
+    } catch (const std::bad_alloc&) {
+      // Under a memory limit (ulimit -v) the budgets below may not be
+      // reached first: still say where.
+      failAt({file, word.line}, word.text + ": out of memory while importing this statement");
+    }
   }
+  pendingInstances_.pop_back();
 }
 
 static Mat matrixFrom16(const std::vector<double>& v) {
@@ -286,7 +346,7 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
   } else if (s == "Camera") {
     requireOptions(at, s);
     std::string type = c.string(s);
-    camera_ = {type, c.params("Camera \"" + type + "\""), at, true};
+    camera_ = {type, c.params("Camera \"" + type + "\""), at, true, statementCount_};
     cameraCtm_[0] = gs_.ctm[0];
     cameraCtm_[1] = gs_.ctm[1];
     for (int i = 0; i < 2; ++i) {
@@ -297,7 +357,7 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
   } else if (s == "Film" || s == "Sampler" || s == "Integrator" || s == "PixelFilter") {
     requireOptions(at, s);
     std::string type = c.string(s);
-    Statement st{type, c.params(s + " \"" + type + "\""), at, true};
+    Statement st{type, c.params(s + " \"" + type + "\""), at, true, statementCount_};
     (s == "Film" ? film_ : s == "Sampler" ? sampler_ : s == "Integrator" ? integrator_ : pixelFilter_) = std::move(st);
   } else if (s == "Accelerator" || s == "ColorSpace") {
     std::string type = c.string(s);
@@ -312,6 +372,7 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
     inWorld_ = false;
     worldEnded_ = true;
   } else if (s == "AttributeBegin" || s == "TransformBegin") {
+    checkNesting(at, s);
     stack_.push_back({gs_, s == "AttributeBegin", at});
   } else if (s == "AttributeEnd" || s == "TransformEnd") {
     bool attribute = s == "AttributeEnd";
@@ -327,6 +388,9 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
   } else if (s == "Include" || s == "Import") {
     std::string name = c.string(s);
     if (depth + 1 > kMaxIncludeDepth) failAt(at, s + " \"" + name + "\": nested more than 32 deep (an include cycle?)");
+    if (++includes_ > scene::limits::kMaxPbrtIncludes)
+      failAt(at, s + " \"" + name + "\": more than " + std::to_string(scene::limits::kMaxPbrtIncludes) +
+                     " Include/Import statements in one scene (files that include each other repeatedly?)");
     parseFile(resolvePath(name, c.file(), mainDir), depth + 1, at.str() + ": " + s + ": ");
   } else if (s == "Shape") {
     requireWorld(at, s);
@@ -364,12 +428,15 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
     requireWorld(at, s);
     std::string type = c.string(s);
     ParamSet ps = c.params("AreaLightSource \"" + type + "\"");
-    if (type != "diffuse") failAt(at, "AreaLightSource \"" + type + "\" is not supported (only \"diffuse\")");
+    // pbrt-v3 also accepts "area" for its (only) diffuse area light.
+    if (type != "diffuse" && type != "area")
+      failAt(at, "AreaLightSource \"" + type + "\" is not supported (only \"diffuse\", or pbrt-v3's alias \"area\")");
     gs_.area = AreaLight{std::move(ps), at};
   } else if (s == "ObjectBegin") {
     requireWorld(at, s);
     std::string name = c.string(s);
     if (currentInstance_) failAt(at, "ObjectBegin \"" + name + "\" inside the definition of \"" + currentInstanceName_ + "\"");
+    checkNesting(at, s);
     stack_.push_back({gs_, true, at});
     currentInstance_ = &instances_[name];
     currentInstance_->clear();
@@ -387,9 +454,38 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
     if (currentInstance_) failAt(at, "ObjectInstance inside an object definition is not supported");
     auto it = instances_.find(name);
     if (it == instances_.end()) failAt(at, "ObjectInstance: no object named \"" + name + "\" has been defined");
+    // Pre-flight: once an object's triangle count is known (its first
+    // instance), this copy and the later ones in this file are counted
+    // before this one is made.
+    uint64_t later = 0;
+    if (!pendingInstances_.empty()) {
+      uint64_t& p = pendingInstances_.back()[name];
+      if (p > 0) --p;
+      later = p;
+    }
+    auto preflight = [&](uint64_t perCopy) {
+      if (perCopy == 0) return;
+      uint64_t copies = std::min<uint64_t>(later, (uint64_t(1) << 62) / perCopy);
+      countTriangles(perCopy * (1 + copies), at,
+                     "ObjectInstance \"" + name + "\"" + (copies ? " (with its " + std::to_string(later) + " later copies in this file)" : ""),
+                     false);
+    };
+    auto known = instanceTriangles_.find(name);
+    if (known != instanceTriangles_.end()) preflight(known->second);
+    uint64_t before = triangles_;
     for (const ShapeRecord& rec : it->second) {
       Mat ctm[2] = {gs_.ctm[0] * rec.ctm[0], gs_.ctm[1] * rec.ctm[1]};
       emitShape(rec, ctm, at);
+    }
+    if (known == instanceTriangles_.end()) {
+      instanceTriangles_[name] = triangles_ - before;
+      // The copies still to come, counted now that one copy's size is known.
+      uint64_t perCopy = triangles_ - before;
+      if (perCopy > 0 && later > 0) {
+        uint64_t copies = std::min<uint64_t>(later, (uint64_t(1) << 62) / perCopy);
+        countTriangles(perCopy * copies, at,
+                       "ObjectInstance \"" + name + "\" (its " + std::to_string(later) + " later copies in this file)", false);
+      }
     }
   } else if (s == "ReverseOrientation") {
     failAt(at, "ReverseOrientation is not supported (tdpm cannot flip a sphere's or an emitter's orientation)");
@@ -399,6 +495,32 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
 }
 
 // ------------------------------------------------------------ options block
+
+namespace {
+// The error of the options statement that comes first in the file (by
+// statement number; a statement not given counts as last).
+struct FirstError {
+  int64_t seq = std::numeric_limits<int64_t>::max();
+  std::string what;
+  bool any = false;
+  template <class F>
+  void run(const Statement& st, F&& f) {
+    try {
+      f();
+    } catch (const Error& e) {
+      int64_t s = st.given ? st.seq : std::numeric_limits<int64_t>::max();
+      if (!any || s < seq) {
+        seq = s;
+        what = e.what();
+        any = true;
+      }
+    }
+  }
+  void rethrow() const {
+    if (any) throw Error(what);
+  }
+};
+}  // namespace
 
 static float verticalFov(double fov, int w, int h) {
   // pbrt's fov spans the shorter image axis; tdpm's is vertical.
@@ -413,17 +535,25 @@ void Importer::worldBegin(const Loc& at) {
   scene::SceneDescription& sc = result.scene;
   scene::RenderSettings& r = sc.render;
 
+  // The options statements are mapped here in the order their values
+  // depend on each other (Film, Camera, Sampler, PixelFilter, Integrator).
+  // A failing one is recorded and the others still run, so that the error
+  // reported is the first in the file, as for every other statement.
+  FirstError first;
+
   // Film
   int width = 640, height = 480;
   bool v4Film = false;
+  first.run(film_, [&] {
   if (film_.given) {
     const ParamSet& ps = film_.params;
     if (film_.type == "rgb" || film_.type == "gbuffer" || film_.type == "spectral") v4Film = true;
     else if (film_.type != "image") failAt(film_.at, "Film \"" + film_.type + "\" is not supported (image, rgb, gbuffer, spectral)");
-    width = ps.getInt("xresolution", 640);
-    height = ps.getInt("yresolution", 480);
-    if (width < 1 || height < 1 || width > 65536 || height > 65536)
-      failAt(film_.at, "Film: resolution " + std::to_string(width) + "x" + std::to_string(height) + " is outside 1..65536");
+    int w = ps.getInt("xresolution", 640), h = ps.getInt("yresolution", 480);
+    if (w < 1 || h < 1 || w > 65536 || h > 65536)
+      failAt(film_.at, "Film: resolution " + std::to_string(w) + "x" + std::to_string(h) + " is outside 1..65536");
+    width = w;
+    height = h;
     if (ps.has("filename")) result.filmFilename = ps.getString("filename", "");
     std::vector<double> crop = ps.getFloats("cropwindow");
     if (!crop.empty() && !(crop.size() == 4 && crop[0] == 0 && crop[1] == 1 && crop[2] == 0 && crop[3] == 1))
@@ -438,14 +568,23 @@ void Importer::worldBegin(const Loc& at) {
       if (ps.getFloat("whitebalance", 0) != 0) ps.fail(*ps.find("whitebalance"), "white balancing is not supported");
       if (ps.getString("sensor", "cie1931") != "cie1931") ps.fail(*ps.find("sensor"), "only the cie1931 sensor is supported");
       imagingRatio_ = iso / 100.0;  // times the exposure time, below
+    } else if (ps.has("scale")) {
+      // pbrt-v3's image film multiplies every pixel by "scale": exact as a
+      // factor on every light (light transport is linear).
+      double scale = ps.getFloat("scale", 1);
+      if (!(scale > 0)) ps.fail(*ps.find("scale"), "must be positive, got " + fmtNum(scale));
+      imagingRatio_ = scale;
+      filmFactorWhat_ = "pbrt-v3's Film \"image\" scales the image by \"scale\"";
     }
     ps.checkAllUsed();
   }
+  });
   sc.camera.width = width;
   sc.camera.height = height;
 
   // Camera (pbrt's default: perspective, fov 90, at the origin looking down +z)
   double fov = 90;
+  first.run(camera_, [&] {
   if (camera_.given) {
     const ParamSet& ps = camera_.params;
     if (camera_.type != "perspective") failAt(camera_.at, "Camera \"" + camera_.type + "\" is not supported (only perspective)");
@@ -460,21 +599,27 @@ void Importer::worldBegin(const Loc& at) {
     ps.markUsed("focaldistance");
     ps.checkAllUsed();
   }
+  });
+  first.run(film_, [&] {
   if (v4Film) {
     imagingRatio_ *= double(shutterClose_) - double(shutterOpen_);
     if (!(imagingRatio_ > 0))
       failAt(film_.at, "Film: pbrt-v4 scales the image by exposure time x ISO / 100, which is 0 here (zero-length shutter or iso 0)");
   }
+  });
   sc.camera.shutterOpen = shutterOpen_;
   sc.camera.shutterClose = shutterClose_;
   sc.camera.fovDegrees = verticalFov(fov, width, height);
 
   // The camera frame: camera-to-world C = inverse(CTM at Camera).
+  first.run(camera_, [&] {
   Loc camAt = camera_.given ? camera_.at : at;
   Mat C[2] = {*cameraCtm_[0].inverse(), *cameraCtm_[1].inverse()};
   struct Frame3 { Vec3f pos, fwd, up; };
   Frame3 f[2];
   for (int i = 0; i < 2; ++i) {
+    std::string degenerate = scaleProblem(C[i]);
+    if (!degenerate.empty()) failAt(camAt, "Camera: the camera transform is unusable: " + degenerate);
     std::optional<Pose> p = decompose(C[i]);
     bool similar = p && std::fabs(std::fabs(p->scale.x) - std::fabs(p->scale.y)) <= 1e-5f * std::fabs(p->scale.x) &&
                    std::fabs(std::fabs(p->scale.x) - std::fabs(p->scale.z)) <= 1e-5f * std::fabs(p->scale.x);
@@ -518,7 +663,10 @@ void Importer::worldBegin(const Loc& at) {
     }
   }
 
+  });
+
   // Sampler -> spp
+  first.run(sampler_, [&] {
   if (sampler_.given) {
     const ParamSet& ps = sampler_.params;
     static const std::set<std::string> kSamplers = {"halton", "sobol", "zsobol", "paddedsobol", "pmj02bn", "independent",
@@ -553,10 +701,12 @@ void Importer::worldBegin(const Loc& at) {
   } else {
     r.spp = 16;  // pbrt's default pixelsamples
   }
+  });
 
-  mapPixelFilter(r, v4Film);
+  first.run(pixelFilter_, [&] { mapPixelFilter(r, v4Film); });
 
   // Integrator -> method
+  first.run(integrator_, [&] {
   std::string integ = integrator_.given ? integrator_.type : "path";
   const ParamSet& ip = integrator_.params;
   Loc iat = integrator_.given ? integrator_.at : at;
@@ -580,7 +730,12 @@ void Importer::worldBegin(const Loc& at) {
     if (!(radius > 0)) failAt(iat, "Integrator \"sppm\": radius must be positive");
     int64_t per = perIteration > 0 ? perIteration : int64_t(width) * height;
     r.method = "time";
-    r.photons = std::min(kMaxPhotons, per * iterations);
+    if (per > kMaxPhotons / iterations)
+      failAt(iat, "Integrator \"sppm\": photonsperiteration x numiterations = " + std::to_string(per) + " x " +
+                      std::to_string(iterations) + " photons is more than tdpm's limit of " + std::to_string(kMaxPhotons) +
+                      " (render.photons)");
+    r.photons = per * iterations;
+    result.settingSources["photons"] = iat.str() + ": Integrator \"sppm\" (photonsperiteration x numiterations)";
     r.maxRadius = float(radius);
     ip.markUsed("seed");
     note(iat, "Integrator \"sppm\" mapped to tdpm's time-dependent photon method with photons = photonsperiteration x "
@@ -589,6 +744,8 @@ void Importer::worldBegin(const Loc& at) {
     failAt(iat, "Integrator \"" + integ + "\" is not supported (path, volpath, sppm)");
   }
   if (integrator_.given) ip.checkAllUsed();
+  });
+  first.rethrow();
 
   gs_.ctm[0] = gs_.ctm[1] = Mat();
   coordSystems_["world"] = Mat();
@@ -601,19 +758,31 @@ void Importer::finish(const std::string& file) {
     failAt(stack_.back().at, std::string(stack_.back().attribute ? "AttributeBegin" : "TransformBegin") + " without a matching End");
   if (imagingRatio_ != 1) {
     float k = float(imagingRatio_);
-    for (auto& l : result.scene.lights) l.power = l.power * k;
-    result.scene.background = result.scene.background * k;
-    result.notes.push_back(film_.at.str() + ": Film: pbrt-v4 scales the image by exposure time x ISO / 100 = " +
-                           fmtNum(imagingRatio_) + "; the import scales every light by it");
+    for (auto& l : result.scene.lights) {
+      l.power = l.power * k;
+      if (!std::isfinite(l.power.r) || !std::isfinite(l.power.g) || !std::isfinite(l.power.b))
+        failAt(film_.at, "Film: " + filmFactorWhat_ + " = " + fmtNum(imagingRatio_) + ", which makes " +
+                             l.name + " infinitely bright (its power overflows a float)");
+    }
+    if (!result.scene.background.isBlack()) result.scene.background = result.scene.background * k;
+    if (!std::isfinite(result.scene.background.r) || !std::isfinite(result.scene.background.g) ||
+        !std::isfinite(result.scene.background.b))
+      failAt(film_.at, "Film: " + filmFactorWhat_ + " = " + fmtNum(imagingRatio_) +
+                           ", which makes the infinite light's radiance overflow a float");
+    result.notes.push_back(film_.at.str() + ": Film: " + filmFactorWhat_ + " = " + fmtNum(imagingRatio_) +
+                           "; the import scales every light by it");
   }
+  validateAsJson();
 }
 
 }  // namespace tdpm::pbrt::detail
 
 namespace tdpm::pbrt {
 
-ImportResult importPbrtText(const std::string& text, const std::string& path) {
+ImportResult importPbrtText(const std::string& text, const std::string& path, uint64_t maxTriangles) {
   detail::Importer im;
+  im.start();
+  if (maxTriangles) im.maxTriangles = maxTriangles;
   im.result.scene.sourcePath = path;
   im.mainDir = std::filesystem::path(path).parent_path().string();
   im.parseText(text, path, 0);
@@ -623,6 +792,7 @@ ImportResult importPbrtText(const std::string& text, const std::string& path) {
 
 ImportResult importPbrtFile(const std::string& path) {
   detail::Importer im;
+  im.start();
   im.result.scene.sourcePath = path;
   im.mainDir = std::filesystem::path(path).parent_path().string();
   im.parseFile(path, 0, "");

@@ -11,10 +11,12 @@
 #include <string>
 #include <vector>
 
+#include "core/memory.h"
 #include "import/pbrt_import.h"
 #include "import/pbrt_math.h"
 #include "import/pbrt_params.h"
 #include "import/pbrt_tokenizer.h"
+#include "scene/limits.h"
 
 namespace tdpm::pbrt::detail {
 
@@ -28,7 +30,6 @@ struct Loc {
 
 [[noreturn]] void failAt(const Loc& at, const std::string& what);
 std::string fmtNum(double v);
-std::string readWholeFile(const std::string& path, const std::string& where);
 // A relative path is looked up beside the file that names it; if it is not
 // there but is beside the main scene file (pbrt's search directory), that
 // one is used, so scenes written for pbrt's rule load too.
@@ -87,6 +88,7 @@ struct Statement {  // an options-block statement kept until WorldBegin
   ParamSet params;
   Loc at;
   bool given = false;
+  int64_t seq = 0;  // statement number in reading order (errors are reported in file order)
 };
 
 class Cursor;
@@ -95,13 +97,16 @@ class Importer {
  public:
   ImportResult result;
 
-  void parseFile(const std::string& path, int depth, const std::string& where) {
-    std::string text = readWholeFile(path, where);
-    parseText(text, path, depth);
-  }
+  // Reads `path` within the import's budgets (scene/limits.h): a regular
+  // file (checked before open: a FIFO would block), at most
+  // kMaxPbrtFileBytes, and kMaxPbrtTotalBytes for all files together.
+  // `where` is the Include's "file:line: Include: " (empty for the main file).
+  void parseFile(const std::string& path, int depth, const std::string& where);
   void parseText(const std::string& text, const std::string& file, int depth);
+  void start() { memoryAtStart_ = availableMemoryBytes(); }
   void finish(const std::string& file);
   std::string mainDir;  // pbrt's search directory: the main scene file's
+  uint64_t maxTriangles = scene::limits::kMaxPbrtTriangles;
 
  private:
   // statements
@@ -129,10 +134,13 @@ class Importer {
   Rgb color(const ParamSet& ps, const std::string& name, Rgb fallback) const;
   double floatParam(const ParamSet& ps, const std::string& name, double fallback) const;
   Rgb lightScale(const ParamSet& ps) const;
+  void noteLightSamples(const ParamSet& ps, const Loc& at, const std::string& what);
   void note(const Loc& at, const std::string& what);
   void requireWorld(const Loc& at, const std::string& stmt) const;
   void requireOptions(const Loc& at, const std::string& stmt) const;
   void mapPixelFilter(scene::RenderSettings& r, bool v4Film);
+  void checkNesting(const Loc& at, const std::string& stmt) const;
+  void countTriangles(uint64_t n, const Loc& at, const std::string& what, bool add = true);
 
   GraphicsState gs_;
   std::vector<StackEntry> stack_;
@@ -146,13 +154,32 @@ class Importer {
   std::set<std::string> materialNames_;
   std::set<std::string> notedKinds_;
 
+  // budgets (scene/limits.h)
+  uint64_t bytesRead_ = 0;
+  int includes_ = 0;
+  uint64_t triangles_ = 0;
+  int64_t statementCount_ = 0;
+  uint64_t memoryAtStart_ = 0;  // MemAvailable when the import began (0: unknown)
+  std::map<std::string, uint64_t> instanceTriangles_;  // per object, once instanced
+  std::vector<std::map<std::string, uint64_t>> pendingInstances_;  // per file being read: ObjectInstance statements to come
+
+  // Where each scene.objects[i] / scene.lights[i] / the background came
+  // from, to name the pbrt statement when the JSON checks refuse it.
+  std::vector<Loc> objectAt_, lightAt_;
+  Loc backgroundAt_;
+  void validateAsJson();
+  Loc locateJsonPath(const std::string& path) const;
+
   bool inWorld_ = false, sawWorld_ = false, worldEnded_ = false;
   float transformStart_ = 0, transformEnd_ = 1;
   Statement camera_, film_, sampler_, integrator_, pixelFilter_;
   Mat cameraCtm_[2];
   bool mirror_ = true;
   float shutterOpen_ = 0, shutterClose_ = 1;
-  double imagingRatio_ = 1;  // pbrt-v4 film: exposure time * ISO / 100
+  double imagingRatio_ = 1;  // pbrt-v4 film: exposure time * ISO / 100; pbrt-v3 image film: "scale"
+  std::string filmFactorWhat_ = "pbrt-v4 scales the image by exposure time x ISO / 100";
+  // pbrt-v3 syntax (Film "image"): notes about pbrt-v4-only behaviour are left out.
+  bool pbrtV3() const { return film_.given && film_.type == "image"; }
   Loc worldAt_;
 
   static MaterialSlot defaultMaterial() {

@@ -64,7 +64,7 @@ void Importer::texture(const std::string& name, const std::string& kind, const s
                        const Loc& at) {
   bool isFloat = kind == "float";
   if (!isFloat && kind != "spectrum" && kind != "color" && kind != "rgb")
-    failAt(at, "Texture \"" + name + "\": unknown texture kind \"" + kind + "\" (float or spectrum)");
+    failAt(at, "Texture \"" + name + "\": unknown texture kind \"" + kind + "\" (float, spectrum, or pbrt-v3's color/rgb)");
   TextureValue t;
   t.isFloat = isFloat;
   if (type == "constant") {
@@ -87,7 +87,7 @@ void Importer::texture(const std::string& name, const std::string& kind, const s
     note(at, "Texture \"" + name + "\": the checkerboard's antialiasing filter is not applied (tdpm supersamples instead)");
     t.checker = c;
   } else {
-    failAt(at, "Texture \"" + name + "\": type \"" + type + "\" is not supported (constant)");
+    failAt(at, "Texture \"" + name + "\": type \"" + type + "\" is not supported (supported: constant, and checkerboard as a reflectance)");
   }
   ps.checkAllUsed();
   textures_[name] = t;
@@ -235,6 +235,15 @@ uint32_t Importer::materialIndex(int slot) {
 
 // ------------------------------------------------------------ lights
 
+// pbrt's light sample counts only change noise: ignored, with one note.
+void Importer::noteLightSamples(const ParamSet& ps, const Loc& at, const std::string& what) {
+  for (const char* q : {"nsamples", "samples"})
+    if (ps.has(q)) {
+      ps.markUsed(q);
+      note(at, what + ": \"" + q + "\" ignored (quality only: tdpm chooses its own light samples)");
+    }
+}
+
 Rgb Importer::lightScale(const ParamSet& ps) const {
   const Param* p = ps.find("scale");
   if (!p) return Rgb(1.0f);
@@ -256,6 +265,7 @@ void Importer::lightSource(const std::string& type, const ParamSet& ps, const Lo
     note(at, "LightSource: lights do not move in pbrt; the StartTime transform is used (as pbrt does)");
   Rgb sc = lightScale(ps);
   double power = ps.has("power") ? ps.getFloat("power", -1) : -1;
+  noteLightSamples(ps, at, "LightSource \"" + type + "\"");
   scene::LightDesc l;
   l.name = "LightSource \"" + type + "\" (" + at.str() + ")";
   if (type == "point") {
@@ -272,6 +282,8 @@ void Importer::lightSource(const std::string& type, const ParamSet& ps, const Lo
     double cosT = std::cos(cone * kPiD / 180), cosS = std::cos((cone - delta) * kPiD / 180);
     if (power > 0) I = I * float(power / (2 * kPiD * ((1 - cosS) + (cosS - cosT) / 2)));  // pbrt-v4's k_e
     Vec3f from = ps.getPoint("from", {0, 0, 0}), to = ps.getPoint("to", {0, 0, 1});
+    std::string degenerate = scaleProblem(M);
+    if (!degenerate.empty()) failAt(at, "LightSource \"spot\": its transform is unusable: " + degenerate);
     Vec3f dir = M.vector(to - from);
     if (!(length(dir) > 0)) failAt(at, "LightSource \"spot\": from and to coincide");
     std::optional<Pose> p = decompose(M);
@@ -285,7 +297,8 @@ void Importer::lightSource(const std::string& type, const ParamSet& ps, const Lo
     l.falloffStart = float(cone - delta);
     float solid = float(2 * kPiD * ((1 - cosS) + (cosS - cosT) / 5));  // tdpm's exact integral of the quartic falloff
     l.power = I * solid;
-    if (delta > 0)
+    // Exact for pbrt-v3 (Film "image"); a pbrt-v4 or unmarked file is told.
+    if (delta > 0 && !pbrtV3())
       note(at, "LightSource \"spot\": the falloff band uses pbrt-v3's quartic curve; pbrt-v4 uses smoothstep there");
   } else if (type == "distant") {
     if (power > 0) failAt(at, "LightSource \"distant\": \"power\" depends on pbrt's scene radius; give L instead");
@@ -300,15 +313,16 @@ void Importer::lightSource(const std::string& type, const ParamSet& ps, const Lo
     if (ps.has("filename") || ps.has("mapname")) failAt(at, "LightSource \"infinite\": an environment map is not supported (constant L only)");
     if (power > 0 || ps.has("illuminance")) failAt(at, "LightSource \"infinite\": \"power\"/\"illuminance\" is not supported; give L");
     Rgb L = nonNegative(ps, "L", color(ps, "L", Rgb(1.0f))) * sc;
-    for (const char* q : {"nsamples", "samples"}) ps.markUsed(q);
     ps.checkAllUsed();
     result.scene.background = result.scene.background + L;
+    backgroundAt_ = at;
     return;
   } else {
     failAt(at, "LightSource \"" + type + "\" is not supported (point, spot, distant, infinite)");
   }
   ps.checkAllUsed();
   result.scene.lights.push_back(l);
+  lightAt_.push_back(at);
 }
 
 // ------------------------------------------------------------ shapes
@@ -334,9 +348,9 @@ struct Geometry {
 };
 }  // namespace
 
-static std::vector<Vec3f> readPoints(const ParamSet& ps, const std::string& name) {
+static std::vector<Vec3f> readPoints(const ParamSet& ps, const std::string& name, const Loc& at) {
   const Param* p = ps.find(name);
-  if (!p) throw Error(ps.file() + ": " + ps.statement() + ": missing parameter \"point3 " + name + "\"");
+  if (!p) failAt(at, ps.statement() + ": missing parameter \"point3 " + name + "\"");
   if (p->type != "point3") ps.fail(*p, "expected type point3");
   std::vector<double> v = ps.getFloats(name);
   if (v.empty() || v.size() % 3) ps.fail(*p, "expected a non-empty multiple of 3 numbers, got " + std::to_string(v.size()));
@@ -345,13 +359,14 @@ static std::vector<Vec3f> readPoints(const ParamSet& ps, const std::string& name
   return out;
 }
 
-static std::vector<uint32_t> readIndices(const ParamSet& ps, size_t vertexCount, size_t per, const std::string& what) {
+static std::vector<uint32_t> readIndices(const ParamSet& ps, size_t vertexCount, size_t per, const std::string& what,
+                                         const Loc& at) {
   const Param* p = ps.find("indices");
   std::vector<uint32_t> out;
   if (!p) {
     if (vertexCount != per)
-      throw Error(ps.file() + ": " + ps.statement() + ": missing parameter \"integer indices\" (only a single " + what +
-                  " of " + std::to_string(per) + " points may omit it)");
+      failAt(at, ps.statement() + ": missing parameter \"integer indices\" (only a single " + what + " of " +
+                     std::to_string(per) + " points may omit it)");
     for (uint32_t i = 0; i < per; ++i) out.push_back(i);
     return out;
   }
@@ -380,7 +395,9 @@ static void addQuads(const std::vector<Vec3f>& P, const std::vector<uint32_t>& q
   }
 }
 
-static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(const std::string&)>& note, const std::string& mainDir) {
+// `inputs` collects the files read (PLY meshes).
+static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(const std::string&)>& note, const std::string& mainDir,
+                             std::vector<std::string>& inputs) {
   const ParamSet& ps = rec.params;
   Geometry g;
   if (rec.type == "sphere") {
@@ -393,8 +410,8 @@ static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(co
     g.radius = float(r);
   } else if (rec.type == "trianglemesh" || rec.type == "bilinearmesh") {
     bool bilinear = rec.type == "bilinearmesh";
-    std::vector<Vec3f> P = readPoints(ps, "P");
-    std::vector<uint32_t> idx = readIndices(ps, P.size(), bilinear ? 4 : 3, bilinear ? "patch" : "triangle");
+    std::vector<Vec3f> P = readPoints(ps, "P", rec.at);
+    std::vector<uint32_t> idx = readIndices(ps, P.size(), bilinear ? 4 : 3, bilinear ? "patch" : "triangle", rec.at);
     std::vector<double> uv = ps.getFloats(ps.has("uv") ? "uv" : "st");
     if (!uv.empty()) {
       if (uv.size() != 2 * P.size()) ps.fail(*ps.find(ps.has("uv") ? "uv" : "st"), "expected 2 numbers per point");
@@ -432,12 +449,19 @@ static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(co
     ps.markUsed("edgelength");
     PlyMesh ply;
     try {
-      ply = readPly(resolvePath(file, rec.at.file, mainDir));
+      std::string path = resolvePath(file, rec.at.file, mainDir);
+      ply = readPly(path);
+      inputs.push_back(path);
     } catch (const Error& e) {
       failAt(rec.at, std::string("Shape \"plymesh\": ") + e.what());
     }
-    for (const std::string& q : ply.ignoredProperties)
-      note("Shape \"plymesh\": vertex property \"" + q + "\" ignored (tdpm shades with the geometric normal)");
+    // One note for all of them (nx, ny, nz is one normal, not three notes).
+    if (!ply.ignoredProperties.empty()) {
+      std::string list;
+      for (const std::string& q : ply.ignoredProperties) list += (list.empty() ? "\"" : ", \"") + q + "\"";
+      note(std::string("Shape \"plymesh\": vertex ") + (ply.ignoredProperties.size() > 1 ? "properties " : "property ") + list +
+           " ignored (tdpm shades with the geometric normal)");
+    }
     g.vertices = std::move(ply.vertices);
     g.indices = std::move(ply.triangles);
     addQuads(g.vertices, ply.quads, rec.at, "Shape \"plymesh\" \"" + file + "\"", &g.indices);
@@ -461,6 +485,9 @@ Importer::MotionPlan Importer::planMotion(const Mat ctm[2], const Loc& at, const
   std::optional<Pose> p[2];
   for (int i = 0; i < 2; ++i) {
     p[i] = decompose(ctm[i]);
+    std::string degenerate = scaleProblem(ctm[i]);
+    if (!degenerate.empty())
+      failAt(at, what + ": its " + (i ? "EndTime" : "StartTime") + " transform is unusable: " + degenerate);
     if (!p[i] || ctm[i].det3() < 0)
       failAt(at, what + ": its " + (i ? "EndTime" : "StartTime") +
                      " transform has shear, a scale along rotated axes or a mirror; pbrt would interpolate its polar "
@@ -564,7 +591,9 @@ static CheckerFrame placeChecker(const std::vector<Vec3f>& world, const std::vec
 }
 
 void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& instanceAt) {
-  Geometry g = makeGeometry(rec, [&](const std::string& w) { note(rec.at, w); }, mainDir);
+  Geometry g = makeGeometry(rec, [&](const std::string& w) { note(rec.at, w); }, mainDir, result.inputFiles);
+  countTriangles(g.indices.size() / 3, instanceAt.file.empty() ? rec.at : instanceAt,
+                 instanceAt.file.empty() ? "Shape \"" + rec.type + "\"" : "ObjectInstance (Shape \"" + rec.type + "\" at " + rec.at.str() + ")");
   const MaterialSlot& mat = materials_[size_t(rec.material)];
   if (rec.area) {
     if (g.sphere) failAt(rec.at, "Shape \"sphere\" with an AreaLightSource: tdpm's area lights are rectangles");
@@ -580,6 +609,8 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
     o.shape.type = scene::ShapeDesc::Type::Sphere;
     o.shape.radius = g.radius;
     if (!plan.moving) {
+      std::string degenerate = scaleProblem(plan.still);
+      if (!degenerate.empty()) failAt(rec.at, "Shape \"sphere\": its transform is unusable: " + degenerate);
       std::optional<Pose> p = decompose(plan.still);
       if (!p || !nearlyUniform(p->scale))
         failAt(rec.at, "Shape \"sphere\" under a non-uniform scale or shear (an ellipsoid) is not supported");
@@ -613,6 +644,7 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
       result.scene.materials.push_back(m);
       o.material = uint32_t(result.scene.materials.size() - 1);
       result.scene.objects.push_back(std::move(o));
+      objectAt_.push_back(rec.at);
       return;
     }
     if (!plan.moving) {
@@ -632,6 +664,7 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
   }
   o.material = materialIndex(rec.material);
   result.scene.objects.push_back(std::move(o));
+  objectAt_.push_back(rec.at);
 }
 
 void Importer::emitAreaLight(const ShapeRecord& rec, const std::vector<Vec3f>& verts, const std::vector<uint32_t>& idx,
@@ -677,6 +710,7 @@ void Importer::emitAreaLight(const ShapeRecord& rec, const std::vector<Vec3f>& v
   double power = ps.has("power") ? ps.getFloat("power", -1) : -1;
   if (power > 0) L = L * float(power / (kPiD * rectArea));  // pbrt-v4: one side, area A
   if (ps.has("filename")) failAt(rec.area->at, "AreaLightSource: an image emitter (filename) is not supported");
+  noteLightSamples(ps, rec.area->at, "AreaLightSource");
   ps.checkAllUsed();
   scene::LightDesc l;
   l.type = scene::LightDesc::Type::Area;
@@ -690,6 +724,7 @@ void Importer::emitAreaLight(const ShapeRecord& rec, const std::vector<Vec3f>& v
   if (!black)
     note(rec.at, what + ": tdpm's area lights do not reflect light; the emitter's material is ignored");
   result.scene.lights.push_back(l);
+  lightAt_.push_back(rec.area->at);
 }
 
 }  // namespace tdpm::pbrt::detail

@@ -2,6 +2,9 @@
 #include "import/pbrt_math.h"
 
 #include <cmath>
+#include <sstream>
+
+#include "scene/limits.h"
 
 namespace tdpm::pbrt {
 
@@ -206,6 +209,19 @@ std::optional<Pose> decompose(const Mat& m) {
   p.rotate = quaternionFromMatrix(r);
   p.scale = {float(s[0]), float(s[1]), float(s[2])};
   return p;
+}
+
+std::string scaleProblem(const Mat& m) {
+  namespace L = scene::limits;
+  for (int j = 0; j < 3; ++j) {
+    double s = std::sqrt(m.m[0][j] * m.m[0][j] + m.m[1][j] * m.m[1][j] + m.m[2][j] * m.m[2][j]);
+    if (s >= double(L::kMinScale) && s <= double(L::kMaxScale)) continue;
+    std::ostringstream o;
+    o << "it scales an axis by " << s << ", which is " << (s < double(L::kMinScale) ? "degenerate (too small)" : "too large")
+      << "; tdpm needs scale factors in [" << L::kMinScale << ", " << L::kMaxScale << "]";
+    return o.str();
+  }
+  return "";
 }
 
 Mat mirrorX() { return Mat::scale(-1, 1, 1); }

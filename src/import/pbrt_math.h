@@ -3,6 +3,7 @@
 // matrices, and the decomposition of a matrix into tdpm's T * R * S pose.
 #pragma once
 #include <optional>
+#include <string>
 
 #include "math/transform.h"
 #include "math/vec.h"
@@ -40,6 +41,11 @@ struct Pose {
   Vec3f scale{1, 1, 1};
 };
 std::optional<Pose> decompose(const Mat& m);
+// Why `m` cannot be a placement even before shear is asked about: empty
+// when every axis's scale factor (column length) is a finite number in
+// [scene::limits::kMinScale, kMaxScale], else e.g. "it scales an axis by
+// 1e-30, which is degenerate (tdpm needs scale factors in [1e-12, 1e12])".
+std::string scaleProblem(const Mat& m);
 
 Quaternion quaternionFromMatrix(const double r[3][3]);
 

@@ -12,10 +12,15 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/regular_file.h"
+#include "scene/limits.h"
 
 namespace tdpm::pbrt {
 
 namespace {
+
+// An element's count must fit the 32-bit vertex indices tdpm's meshes use.
+constexpr uint64_t kMaxPlyElementCount = uint64_t(0xffffffffu);
 
 enum class Type { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
 
@@ -140,8 +145,14 @@ PlyMesh parsePly(const std::string& bytes, const std::string& name) {
     } else if (key == "element") {
       Element e;
       std::string count;
-      if (!(w >> e.name >> count) || count.find_first_not_of("0123456789") != std::string::npos || count.size() > 12)
+      if (!(w >> e.name >> count) || count.empty() || count.find_first_not_of("0123456789") != std::string::npos)
         fail("malformed line '" + line + "'");
+      // Vertices are indexed by 32-bit integers: a larger count is refused
+      // as such (not as a malformed line), whatever the file holds.
+      size_t digits = count.find_first_not_of('0') == std::string::npos ? 0 : count.size() - count.find_first_not_of('0');
+      if (digits > 10 || std::stoull(count) > kMaxPlyElementCount)
+        fail("element \"" + e.name + "\" claims " + count + " entries, more than tdpm's limit of " +
+             std::to_string(kMaxPlyElementCount));
       e.count = std::stoull(count);
       elements.push_back(e);
     } else if (key == "property") {
@@ -238,10 +249,14 @@ PlyMesh parsePly(const std::string& bytes, const std::string& name) {
 }
 
 PlyMesh readPly(const std::string& path) {
+  // stat before open: a FIFO would block open() for ever.
+  RegularFileCheck f = checkRegularFile(path);
+  if (!f.ok) throw Error(path + ": cannot read PLY file: " + f.problem);
+  if (f.size > scene::limits::kMaxMeshFileBytes)
+    throw Error(path + ": PLY file is too large (" + std::to_string(f.size) + " bytes; at most " +
+                std::to_string(scene::limits::kMaxMeshFileBytes >> 20) + " MiB)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path + ": cannot read PLY file (" + std::strerror(errno) + ")");
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw Error(path + ": cannot read PLY file: not a regular file");
   std::ostringstream s;
   s << in.rdbuf();
   if (in.bad()) throw Error(path + ": error while reading PLY file");

@@ -17,11 +17,13 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
-// Exactly as scene/parse.cpp reads a rotation (safeNormalize, then
-// fromAxisAngle with degrees * (pi / 180) in float).
+// Exactly as scene/parse.cpp normalises a direction or a rotation axis
+// (its safeNormalize: in double, then rounded to float). It used to divide
+// by the largest component in float first; this copy still did, so a spot
+// light's direction came back from the JSON up to 1 ulp off (issue 23).
 Vec3f parserNormalize(Vec3f v) {
-  float m = std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)});
-  return normalize(v / m);
+  double x = v.x, y = v.y, z = v.z, len = std::sqrt(x * x + y * y + z * z);
+  return {float(x / len), float(y / len), float(z / len)};
 }
 
 // The shortest decimal that reads back as the same float (so the JSON shows
@@ -165,7 +167,7 @@ Vec3f canonicalDirection(Vec3f d) {
   return d;
 }
 
-SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& jsonPath) {
+SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& jsonPath, bool meshText) {
   SceneJson out;
   std::filesystem::path jp(jsonPath);
   std::string stem = jp.stem().string();
@@ -199,7 +201,7 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
       case scene::ShapeDesc::Type::Box: j["shape"] = Json{{"type", "box"}, {"size", vec(s.size)}}; break;
       case scene::ShapeDesc::Type::Mesh: {
         std::string name = stem + ".mesh" + std::to_string(out.meshFiles.size()) + ".obj";
-        out.meshFiles.push_back({(jp.parent_path() / name).string(), objText(s)});
+        out.meshFiles.push_back({(jp.parent_path() / name).string(), meshText ? objText(s) : std::string()});
         j["shape"] = Json{{"type", "mesh"}, {"file", name}};
         break;
       }

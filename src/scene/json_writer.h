@@ -20,7 +20,9 @@ struct SceneJson {
 };
 
 // `jsonPath` names the output; mesh files are "<stem>.mesh<i>.obj" beside it.
-SceneJson sceneToJson(const scene::SceneDescription& scene, const std::string& jsonPath);
+// Without meshText, meshFiles carry the paths only (empty texts): for
+// validating the JSON with the meshes still in memory (scene::MeshSource).
+SceneJson sceneToJson(const scene::SceneDescription& scene, const std::string& jsonPath, bool meshText = true);
 // Writes the meshes and then the JSON, each atomically.
 void writeSceneJson(const scene::SceneDescription& scene, const std::string& jsonPath);
 

@@ -25,6 +25,32 @@ constexpr uint64_t kMaxMeshFileBytes = uint64_t(1) << 30;  // 1 GiB
 // nlohmann-json parses, since nlohmann's parser recurses.
 constexpr int kMaxJsonDepth = 64;
 
+// ---- pbrt import (import/pbrt_*.cpp): the same kind of budgets as the
+// JSON side, each checked before the work it bounds (docs/pbrt-import.md).
+// One .pbrt file, refused by its size before it is read. Unlike JSON, a
+// pbrt file may carry its meshes inline, so the bound is larger; the
+// tokenizer holds ~56 bytes per token (sizeof(pbrt::Token)), about 8x the
+// text for numbers written with 6 digits.
+constexpr uint64_t kMaxPbrtFileBytes = uint64_t(256) << 20;  // 256 MiB
+// All files of one scene together (the main file and every Include/Import,
+// counted each time it is read): 26 files each including the next twice
+// would otherwise read 2^25 files.
+constexpr uint64_t kMaxPbrtTotalBytes = uint64_t(512) << 20;  // 512 MiB
+// Include/Import statements executed while reading one scene.
+constexpr int kMaxPbrtIncludes = 4096;
+// AttributeBegin/TransformBegin/ObjectBegin open at once (each level keeps
+// a copy of the graphics state; real scenes nest a few dozen deep).
+constexpr int kMaxPbrtNesting = 1024;
+// Triangles in the imported scene, counted with every ObjectInstance before
+// its copy is made (100k instances of a 10k-triangle object would be 1e9).
+// A triangle costs ~170 bytes from import to the built BVH (measured: 1000
+// instances of a 9800-triangle object, `tdpm render -m pathtrace --spp 1
+// --resolution 4x3`, peak RSS 1.66 GB against 15 MB for one instance); the
+// import also refuses a scene whose triangles would not fit in the memory
+// available when it began.
+constexpr uint64_t kMaxPbrtTriangles = uint64_t(1) << 27;  // 134M
+constexpr uint64_t kPbrtBytesPerTriangle = 170;
+
 // ---- coordinates
 // Largest absolute coordinate (metres) of anything the ray tracer sees:
 // every object's vertices or sphere bounds, in object space and in world

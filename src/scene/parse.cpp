@@ -435,11 +435,18 @@ std::string resolveMeshPath(const std::string& file, const std::string& sceneDir
   return (std::filesystem::path(sceneDir) / p).lexically_normal().string();
 }
 
+// Set while parseScene(text, path, meshes) runs (on this thread only).
+thread_local const MeshSource* tMeshSource = nullptr;
+
 void readMesh(const Node& n, const std::string& sceneDir, ShapeDesc* shape) {
   Node fileNode = n.required("file");
   std::string file = fileNode.string();
   fileNode.require(!file.empty(), "mesh file name must not be empty");
   shape->meshFile = resolveMeshPath(file, sceneDir);
+  if (tMeshSource) {
+    if (!(*tMeshSource)(file, &shape->vertices, &shape->indices)) fileNode.fail("no mesh \"" + file + "\" in memory");
+    return;
+  }
   ObjMesh mesh;
   std::string problem;
   if (!loadObjMesh(shape->meshFile, &mesh, &problem)) fileNode.fail(problem);
@@ -808,6 +815,15 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
   }
   Source source{sourcePath, &locator};
   return readScene(Node(doc, "", source), sourcePath);
+}
+
+SceneDescription parseScene(const std::string& jsonText, const std::string& sourcePath, const MeshSource& meshes) {
+  struct Restore {
+    const MeshSource* old;
+    ~Restore() { tMeshSource = old; }
+  } restore{tMeshSource};
+  tMeshSource = &meshes;
+  return parseScene(jsonText, sourcePath);
 }
 
 SceneDescription loadScene(const std::string& path) {

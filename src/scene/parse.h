@@ -3,7 +3,9 @@
 // errors. Every error is a tdpm::Error whose message names the file, the
 // JSON path and (where known) the line: "scene.json:14: objects[2].motion[1].translate: ..."
 #pragma once
+#include <functional>
 #include <string>
+#include <vector>
 
 #include "scene/description.h"
 
@@ -14,5 +16,12 @@ SceneDescription loadScene(const std::string& path);
 
 // Parses JSON text. `sourcePath` is used in messages and to resolve meshes.
 SceneDescription parseScene(const std::string& jsonText, const std::string& sourcePath);
+
+// For importers that validate what they made by the JSON format's own
+// checks (import/pbrt_import.cpp): mesh shapes take their vertices and
+// indices from `meshes(file, &vertices, &indices)` (file as written in the
+// JSON) instead of reading OBJ files; false means "no such mesh".
+using MeshSource = std::function<bool(const std::string& file, std::vector<Vec3f>* vertices, std::vector<uint32_t>* indices)>;
+SceneDescription parseScene(const std::string& jsonText, const std::string& sourcePath, const MeshSource& meshes);
 
 }  // namespace tdpm::scene
