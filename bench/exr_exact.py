@@ -20,7 +20,7 @@ import sys
 import zlib
 from itertools import accumulate
 
-IGNORED_ATTRIBUTES = {"tdpm/render_seconds", "tdpm/progressive/scalar/seconds"}
+IGNORED_ATTRIBUTES = {"tdpm/render_seconds", "tdpm/progressive_seconds", "tdpm/progressive/scalar/seconds"}
 LINES_PER_CHUNK = {0: 1, 1: 1, 2: 1, 3: 16}  # NONE, RLE, ZIPS, ZIP (what tdpm may write)
 PIXEL_BYTES = {0: 4, 1: 2, 2: 4}  # UINT, HALF, FLOAT
 
