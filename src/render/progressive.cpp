@@ -24,6 +24,7 @@
 #include "estimate/estimators.h"
 #include "photon/tracer.h"
 #include "render/camera_sample.h"
+#include "render/pixel_loop.h"
 #include "render/memory_budget.h"
 #include "render/photon_integrator.h"
 #include "render/photon_map.h"
@@ -160,49 +161,52 @@ void renderPassPixels(const Scene& scene, const PhotonIntegrator& integ, const R
   plan.times.fixed01 = fixedTime01;
   plan.times.moving = scene.hasMotion;
   forEachTile<Scratch<PhotonIntegrator>>(w, h, stage, progress, [&](const Tile& t, Scratch<PhotonIntegrator>& s) {
-    for (int y = t.y0; y < t.y1; ++y)
-      for (int x = t.x0; x < t.x1; ++x) {
-        size_t idx = size_t(y) * size_t(w) + size_t(x);
-        const uint32_t m = counts.empty() ? uint32_t(spp) : counts[idx];
-        const uint32_t first = uint32_t(pass) * m;
-        PixelSampler ps(opt.seed, idx);
-        ps.startBatch(first, int(m));
-        Rgb v;
-        if (m == uint32_t(spp)) {
-          double acc[3] = {0, 0, 0};
-          for (uint32_t i = first; i < first + m; ++i) {
-            const CameraRay ray = cameraRay(cam, plan, ps, x, y, i);
-            typename PixelSampler::Stream stream = ps.stream(i);
+    // The pixel in flight: its count m, its first index, and its sums (all
+    // samples full when m == spp; else eye and rest apart).
+    uint32_t m = 0, first = 0;
+    double eye[3], rest[3];
+    samplePixels<PixelSampler>(
+        t, w, cam, plan, opt.seed,
+        [&](size_t idx, uint32_t& f, uint32_t& c) {
+          m = counts.empty() ? uint32_t(spp) : counts[idx];
+          first = uint32_t(pass) * m;
+          f = first;
+          c = m;
+          for (int k = 0; k < 3; ++k) eye[k] = rest[k] = 0;
+          return true;
+        },
+        [&](size_t, uint32_t i, const CameraRay& ray, typename PixelSampler::Stream& stream) {
+          if (m == uint32_t(spp)) {
             Rgb L = integ.radiance(ray.origin, ray.direction, ray.time01, stream, s.state);
             if (!isFinite(L)) L = saturateSample(L);
-            for (int c = 0; c < 3; ++c) acc[c] += double(L[c]);
+            for (int c = 0; c < 3; ++c) rest[c] += double(L[c]);
+            return;
           }
-          const double dm = double(m);
-          v = saturateSample(Rgb(float(acc[0] / dm), float(acc[1] / dm), float(acc[2] / dm)));
-        } else {
-          double eye[3] = {0, 0, 0}, rest[3] = {0, 0, 0};
-          for (uint32_t i = first; i < first + m; ++i) {
-            const CameraRay ray = cameraRay(cam, plan, ps, x, y, i);
-            typename PixelSampler::Stream stream = ps.stream(i);
-            Rgb e, L(0.0f);
-            if (i < first + uint32_t(spp)) {
-              L = saturateSample(integ.radianceSplit(ray.origin, ray.direction, ray.time01, stream, s.state, e));
-              e = saturateSample(e);
-              L = saturateSample(L - e);
-            } else {
-              e = saturateSample(integ.eyePart(ray.origin, ray.direction, ray.time01, stream, s.state));
-            }
-            for (int c = 0; c < 3; ++c) {
-              eye[c] += double(e[c]);
-              rest[c] += double(L[c]);
-            }
+          Rgb e, L(0.0f);
+          if (i < first + uint32_t(spp)) {
+            L = saturateSample(integ.radianceSplit(ray.origin, ray.direction, ray.time01, stream, s.state, e));
+            e = saturateSample(e);
+            L = saturateSample(L - e);
+          } else {
+            e = saturateSample(integ.eyePart(ray.origin, ray.direction, ray.time01, stream, s.state));
           }
-          Rgb r;
-          for (int c = 0; c < 3; ++c) r[c] = float(eye[c] / double(m) + rest[c] / double(spp));
-          v = saturateSample(r);
-        }
-        for (int c = 0; c < 3; ++c) out[3 * idx + size_t(c)] = v[c];
-      }
+          for (int c = 0; c < 3; ++c) {
+            eye[c] += double(e[c]);
+            rest[c] += double(L[c]);
+          }
+        },
+        [&](size_t idx) {
+          Rgb v;
+          if (m == uint32_t(spp)) {
+            const double dm = double(m);
+            v = saturateSample(Rgb(float(rest[0] / dm), float(rest[1] / dm), float(rest[2] / dm)));
+          } else {
+            Rgb r;
+            for (int c = 0; c < 3; ++c) r[c] = float(eye[c] / double(m) + rest[c] / double(spp));
+            v = saturateSample(r);
+          }
+          for (int c = 0; c < 3; ++c) out[3 * idx + size_t(c)] = v[c];
+        });
     integ.flush(s.state);
   });
 }

@@ -17,6 +17,7 @@
 #include "core/timer.h"
 #include "photon/tracer.h"
 #include "render/camera_sample.h"
+#include "render/pixel_loop.h"
 #include "render/path_tracer.h"
 #include "render/photon_integrator.h"
 #include "render/memory_budget.h"
@@ -121,24 +122,22 @@ void samplePass(const Scene& scene, const Integrator& integrator, const Sampling
                 const Progress& progress, int width, int height) {
   const Camera& cam = scene.camera;
   auto tileFn = [&](const Tile& t, PixelScratch<Integrator>& s) {
-    for (int y = t.y0; y < t.y1; ++y)
-      for (int x = t.x0; x < t.x1; ++x) {
-        size_t idx = size_t(y) * size_t(width) + size_t(x);
-        if (!active[idx]) continue;
-        PixelSampler ps(plan.seed, idx);
-        ps.startBatch(first, count);
-        PixelAccumulator& acc = accs[idx];
-        for (uint32_t i = first; i < first + uint32_t(count); ++i) {
-          const CameraRay ray = cameraRay(cam, plan.camera, ps, x, y, i);
-          typename PixelSampler::Stream stream = ps.stream(i);
+    samplePixels<PixelSampler>(
+        t, width, cam, plan.camera, plan.seed,
+        [&](size_t idx, uint32_t& f, uint32_t& c) {
+          f = first;
+          c = uint32_t(count);
+          return active[idx] != 0;
+        },
+        [&](size_t idx, uint32_t i, const CameraRay& ray, typename PixelSampler::Stream& stream) {
           Rgb L = integrator.radiance(ray.origin, ray.direction, ray.time01, stream, s.state);
           // A NaN sample is a bug upstream; never let it reach the film. An
           // infinite one is a finite scene overflowing float (a tiny
           // emitter of huge power): it saturates, as a sensor would.
           if (!isFinite(L)) L = saturateSample(L);
-          acc.add(L, i);
-        }
-      }
+          accs[idx].add(L, i);
+        },
+        [](size_t) {});
     integrator.flush(s.state);
   };
   dist::Comm& comm = *plan.comm;

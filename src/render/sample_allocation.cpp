@@ -8,6 +8,7 @@
 
 #include "core/rng.h"
 #include "render/camera_sample.h"
+#include "render/pixel_loop.h"
 #include "render/photon_integrator.h"
 #include "render/pixel_share.h"
 #include "render/tile_loop.h"
@@ -94,23 +95,26 @@ std::vector<float> pilotNoise(const Scene& scene, const RenderOptions& opt, cons
   const uint64_t seed = hashCombine(opt.seed, kPilotSeedSalt);
   std::vector<float> mean(n, 0.0f), var(n, 0.0f);
   forEachTile<PilotScratch>(w, h, "pilot", progress, [&](const Tile& t, PilotScratch& s) {
-    for (int y = t.y0; y < t.y1; ++y)
-      for (int x = t.x0; x < t.x1; ++x) {
-        size_t idx = size_t(y) * size_t(w) + size_t(x);
-        SobolPixelSampler ps(seed, idx);
-        double sum = 0, sq = 0;
-        for (uint32_t i = 0; i < uint32_t(kPilotSamples); ++i) {
-          const CameraRay ray = cameraRay(scene.camera, plan, ps, x, y, i);
-          SobolStream stream = ps.stream(i);
+    double sum = 0, sq = 0;  // the pixel in flight's luminance sums
+    samplePixels<SobolPixelSampler>(
+        t, w, scene.camera, plan, seed,
+        [&](size_t, uint32_t& f, uint32_t& c) {
+          f = 0;
+          c = uint32_t(kPilotSamples);
+          sum = sq = 0;
+          return true;
+        },
+        [&](size_t, uint32_t, const CameraRay& ray, SobolStream& stream) {
           Rgb L = saturateSample(eyeOnly.radiance(ray.origin, ray.direction, ray.time01, stream, s.state));
           double l = std::min(double(L.luminance()), 1e30);
           sum += l;
           sq += l * l;
-        }
-        double m = sum / kPilotSamples;
-        mean[idx] = float(m);
-        var[idx] = float(std::max(0.0, (sq - sum * m) / (kPilotSamples - 1)));
-      }
+        },
+        [&](size_t idx) {
+          double m = sum / kPilotSamples;
+          mean[idx] = float(m);
+          var[idx] = float(std::max(0.0, (sq - sum * m) / (kPilotSamples - 1)));
+        });
   }, tileShareOf(comm));
   sharePixels(comm, w, h, mean, true);
   sharePixels(comm, w, h, var, true);
