@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "photon/tracer.h"
+#include "render/photon_map.h"
 
 namespace tdpm {
 
@@ -32,7 +33,7 @@ PhotonCounts photonCounts(const Scene& scene, const RenderOptions& opt) {
   const RenderMethodTraits& method = renderMethodTraits(opt.method);
   if (!method.photonMaps || scene.lights.empty()) return p;
   p.caustic = photon::sceneHasSpecular(scene) ? opt.causticPhotons : 0;
-  p.global = opt.visualizeGlobal || opt.gatherRays > 0 ? opt.globalPhotons : 0;
+  p.global = wantsGlobalMap(opt) ? opt.globalPhotons : 0;
   if (method.inBetweenFrames) {
     size_t frames = size_t(scene.hasMotion ? std::max(1, opt.frames) : 1);
     p.caustic = (p.caustic + frames - 1) / frames;

@@ -302,14 +302,7 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
   // ---- photons: pass 0 sizes the emission with the tracer's pilot; later
   //      passes trace the same number of paths at the next path indices ----
   auto trace = [&](photon::MapKind kind, size_t wanted, const char* key) -> std::unique_ptr<PhotonMap> {
-    PhotonMapSettings ms;
-    ms.trace.kind = kind;
-    ms.trace.seed = opt.seed;
-    ms.trace.maxBounces = opt.maxDepth;
-    ms.trace.spreadInTime = spread;
-    ms.trace.fixedTime01 = passTime >= 0 ? passTime : 0.0f;
-    ms.trace.sampler = opt.sampler;
-    ms.trace.storedWanted = wanted;
+    PhotonMapSettings ms = photonMapSettingsFor(opt, kind, wanted, opt.seed, spread, passTime >= 0 ? passTime : 0.0f);
     auto it = state.scalars.find(key);
     if (it != state.scalars.end()) {
       uint64_t paths = uint64_t(it->second);
@@ -323,7 +316,7 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
     if (!m->warning.empty() && pass == 0) st.warnings.push_back(m->warning);
     return m;
   };
-  bool wantGlobal = opt.visualizeGlobal || opt.gatherRays > 0;
+  const bool wantGlobal = wantsGlobalMap(opt);
   std::unique_ptr<PhotonMap> caustic = trace(photon::MapKind::Caustic, opt.causticPhotons, "photons.caustic_paths_per_pass");
   std::unique_ptr<PhotonMap> global =
       trace(photon::MapKind::Global, wantGlobal ? opt.globalPhotons : 0, "photons.global_paths_per_pass");

@@ -246,21 +246,15 @@ Maps tracePhotonMaps(const Scene& scene, const RenderOptions& opt, size_t causti
                      bool spreadInTime, float fixedTime01, uint64_t seed, const Progress& progress, RenderStats& st,
                      dist::Comm& comm) {
   Maps maps;
-  PhotonMapSettings ms;
-  ms.trace.comm = &comm;
-  ms.spaceTime = opt.spaceTime4D && spreadInTime;
-  ms.kappa = opt.kappa;
-  ms.trace.seed = seed;
-  ms.trace.maxBounces = opt.maxDepth;
-  ms.trace.spreadInTime = spreadInTime;
-  ms.trace.fixedTime01 = fixedTime01;
-  ms.trace.sampler = opt.sampler;
-  ms.trace.kind = photon::MapKind::Caustic;
-  ms.trace.storedWanted = causticWanted;
-  maps.caustic = buildPhotonMap(scene, ms, progress);
-  ms.trace.kind = photon::MapKind::Global;
-  ms.trace.storedWanted = opt.visualizeGlobal || opt.gatherRays > 0 ? globalWanted : 0;
-  maps.global = buildPhotonMap(scene, ms, progress);
+  auto settings = [&](photon::MapKind kind, size_t wanted) {
+    PhotonMapSettings ms = photonMapSettingsFor(opt, kind, wanted, seed, spreadInTime, fixedTime01);
+    ms.trace.comm = &comm;
+    ms.spaceTime = opt.spaceTime4D && spreadInTime;
+    ms.kappa = opt.kappa;
+    return ms;
+  };
+  maps.caustic = buildPhotonMap(scene, settings(photon::MapKind::Caustic, causticWanted), progress);
+  maps.global = buildPhotonMap(scene, settings(photon::MapKind::Global, wantsGlobalMap(opt) ? globalWanted : 0), progress);
   for (const PhotonMap* m : {maps.caustic.get(), maps.global.get()}) {
     st.photonSeconds += m->traceSeconds + m->buildSeconds;
     if (!m->warning.empty()) st.warnings.push_back(m->warning);
