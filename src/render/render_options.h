@@ -101,4 +101,9 @@ struct RenderStats {
   std::vector<std::string> warnings;  // for the user: empty photon maps and the like
 };
 
+// The pixel filter the options ask for (its kind's default radius when
+// filterRadius is 0): every pixel loop (fixed budget, progressive pass,
+// animation frame) samples its camera positions from it (render/renderer.cpp).
+PixelFilter pixelFilterFor(const RenderOptions& opt);
+
 }  // namespace tdpm

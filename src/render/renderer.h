@@ -39,11 +39,6 @@ inline constexpr uint64_t kSamplerBytesPerPixel = 61;
 // black background, lights of zero power (every render path reports them).
 std::vector<std::string> sceneWarnings(const Scene& scene);
 
-// The pixel filter the options ask for (its kind's default radius when
-// filterRadius is 0): every pixel loop (fixed budget, progressive pass,
-// animation frame) samples its camera positions from it.
-PixelFilter pixelFilterFor(const RenderOptions& opt);
-
 
 // Throws tdpm::Error, before any work, when the image and the photon maps
 // the options ask for cannot fit in the machine's available memory

@@ -8,6 +8,7 @@
 
 #include "core/rng.h"
 #include "render/camera_sample.h"
+#include "render/film.h"
 #include "render/pixel_loop.h"
 #include "render/photon_integrator.h"
 #include "render/pixel_share.h"
