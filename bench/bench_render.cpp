@@ -99,7 +99,7 @@ void BM_Render(benchmark::State& state) {
   state.SetLabel(std::string(kScenes[which].file) + " " + method + " " + std::to_string(threads) + "t");
   ThreadLimit limit(threads);
   RenderOptions o;
-  o.method = method;
+  o.method = *parseRenderMethod(method);
   o.spp = 4;
   o.seed = 3;
   // Budgets of the paper, scaled down: cube 900k caustic photons / 20

@@ -63,7 +63,7 @@ struct FrozenReference {
 // seed options.seed + j.
 inline FrozenReference frozenTimeReference(const scene::SceneDescription& d, RenderOptions options, int instants) {
   if (instants < 2 || instants % 2) throw std::runtime_error("frozenTimeReference: instants must be even and >= 2");
-  options.method = "standard";
+  options.method = RenderMethod::Standard;
   const float t0 = d.camera.shutterOpen, ts = d.camera.shutterClose - d.camera.shutterOpen;
   FrozenReference r;
   r.width = d.camera.width;

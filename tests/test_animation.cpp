@@ -79,7 +79,7 @@ double analyticPixel(const Camera& cam, const Shutter& sceneShutter, int x, int 
 
 RenderOptions planeOptions(uint64_t seed) {
   RenderOptions o;
-  o.method = "time";
+  o.method = RenderMethod::Time;
   o.spp = 16;
   o.seed = seed;
   o.causticPhotons = 0;
@@ -279,7 +279,7 @@ TEST_CASE("animation: the standard estimate uses only the frame's own photons") 
   d.objects[0].motion = scene::MotionDesc{};
   d.lights[0].motion = test::translation({0, 0, 0}, {0, 2, 0});  // up 2 m over the timeline: 1/d^2 falls
   RenderOptions o = planeOptions(3);
-  o.method = "standard";
+  o.method = RenderMethod::Standard;
   AnimationOptions ao;
   ao.first = 0;
   ao.last = 3;

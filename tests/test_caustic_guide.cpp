@@ -66,7 +66,7 @@ CausticGuide guideFor(const Scene& s, size_t photons, uint64_t seed, int subdivi
 
 Film renderCube(const Scene& s, float guiding, int spp, uint64_t seed, int threads = 0) {
   RenderOptions o;
-  o.method = "pathtrace";
+  o.method = RenderMethod::PathTrace;
   o.spp = o.maxSpp = spp;
   o.seed = seed;
   o.causticGuiding = guiding;

@@ -45,7 +45,7 @@ scene::SceneDescription causticScene(int width, int height) {
 // direct light (the same computation in both methods) plus the caustic.
 RenderOptions causticOptions(const std::string& method, size_t photons, int spp, uint64_t seed) {
   RenderOptions o;
-  o.method = method;
+  o.method = *parseRenderMethod(method);
   o.spp = spp;
   o.seed = seed;
   o.causticPhotons = photons;

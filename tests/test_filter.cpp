@@ -136,10 +136,10 @@ TEST_CASE("filter: a rendered edge takes the filter's profile, and the image mea
   for (int variant = 0; variant < 3; ++variant) {
     SamplerKind sk = variant == 1 ? SamplerKind::Random : SamplerKind::Sobol;
     RenderOptions o;
-    o.method = "pathtrace";
+    o.method = RenderMethod::PathTrace;
     o.spp = o.maxSpp = 64;
     if (variant == 2) {
-      o.method = "time";
+      o.method = RenderMethod::Time;
       o.progressive = true;
       o.passes = 8;
       o.spp = o.maxSpp = 8;
@@ -165,7 +165,7 @@ TEST_CASE("filter: a rendered edge takes the filter's profile, and the image mea
       double expected = 1.0 - filterCdf(w / 2.0 - (x + 0.5), 1.5);
       double bound = 4 * std::sqrt(expected * (1 - expected) / N) + 1e-6;
       CAPTURE(samplerName(sk));
-      CAPTURE(o.method);
+      CAPTURE(renderMethodName(o.method));
       CAPTURE(x);
       CHECK(std::fabs(col - expected) <= bound);
       CHECK(colBox == (x < w / 2 ? 0.0 : 1.0));  // the box sees no neighbour
@@ -182,7 +182,7 @@ TEST_CASE("filter: gaussian renders are bit-identical on 1 and 2 threads and acr
   d.camera.width = 12;
   d.camera.height = 9;
   RenderOptions o;
-  o.method = "pathtrace";
+  o.method = RenderMethod::PathTrace;
   o.filter = FilterKind::Gaussian;
   o.spp = o.maxSpp = 16;
   Film a = renderOn(d, o, 1);

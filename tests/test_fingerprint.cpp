@@ -80,7 +80,7 @@ TEST_CASE("fingerprint: every image-changing option changes it, and is named") {
     std::function<void(RenderOptions&)> apply;
   };
   const std::vector<Change> changes = {
-      {"method", [](RenderOptions& o) { o.method = "standard"; }},
+      {"method", [](RenderOptions& o) { o.method = RenderMethod::Standard; }},
       {"seed", [](RenderOptions& o) { o.seed = 2; }},
       {"sampler", [](RenderOptions& o) { o.sampler = SamplerKind::Random; }},
       {"spp", [](RenderOptions& o) { o.spp = 8; }},

@@ -42,7 +42,7 @@ TEST_CASE("glass: a dielectric ball under a white sky returns every path with we
       CAPTURE(moving);
       auto s = Scene::build(glassFurnace(moving, centre));
       RenderOptions o;
-      o.method = "pathtrace";
+      o.method = RenderMethod::PathTrace;
       o.spp = o.maxSpp = 32;
       // Grazing rays reflect internally near the critical angle, with
       // Fresnel reflectance near 1, for many bounces: max depth 16 loses
@@ -124,7 +124,7 @@ TEST_CASE("glass: the photon methods split the first glass vertex, so a reflecte
   REQUIRE(highlight.size() >= 8);
   auto renderWith = [&](uint64_t seed) {
     RenderOptions o;
-    o.method = "standard";
+    o.method = RenderMethod::Standard;
     o.spp = 4;
     o.seed = seed;
     o.causticPhotons = 1000;

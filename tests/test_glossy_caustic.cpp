@@ -59,7 +59,7 @@ std::vector<size_t> pixelsSeeing(const Scene& s, uint32_t object) {
 double renderMean(const Scene& s, const std::vector<size_t>& pixels, const std::string& method, int spp,
                   uint64_t seed) {
   RenderOptions o;
-  o.method = method;
+  o.method = *parseRenderMethod(method);
   o.spp = spp;
   o.seed = seed;
   o.causticPhotons = 200000;

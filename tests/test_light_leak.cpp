@@ -41,7 +41,7 @@ ImageSum sumOf(const Film& f) {
 Film renderWith(const scene::SceneDescription& d, const std::string& method, size_t caustic, size_t global) {
   auto scene = Scene::build(d);
   RenderOptions o;
-  o.method = method;
+  o.method = *parseRenderMethod(method);
   o.spp = 2;
   o.seed = 11;
   o.causticPhotons = caustic;

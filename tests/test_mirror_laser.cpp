@@ -102,7 +102,7 @@ Extent brightExtent(const Scene& s, const Film& f, bool viaMirror, float fractio
 
 Film renderLaser(const Scene& s, const std::string& method, float maxDt = -1) {
   RenderOptions o;
-  o.method = method;
+  o.method = *parseRenderMethod(method);
   o.spp = 16;
   o.seed = 5;
   o.causticPhotons = 100000;

@@ -540,7 +540,7 @@ TEST_CASE("output safety: the memory estimate counts films, write buffers and ph
   auto desc = test::emptyScene(1000, 500);
   auto scene = Scene::build(desc);
   RenderOptions opt;
-  opt.method = "pathtrace";
+  opt.method = RenderMethod::PathTrace;
   opt.spp = 4;
   MemoryEstimate e = estimateRenderMemory(*scene, opt, 2);
   CHECK(e.pixels == 500000);

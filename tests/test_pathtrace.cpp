@@ -19,7 +19,7 @@ namespace {
 Film renderScene(const scene::SceneDescription& d, int spp, int maxDepth = 16, uint64_t seed = 7) {
   auto s = Scene::build(d);
   RenderOptions o;
-  o.method = "pathtrace";
+  o.method = RenderMethod::PathTrace;
   o.spp = spp;
   o.maxDepth = maxDepth;
   o.seed = seed;

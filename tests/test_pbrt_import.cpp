@@ -49,7 +49,7 @@ std::string errorOf(const std::string& text, const std::string& file = "dir/t.pb
 Film renderDesc(const scene::SceneDescription& d, const std::string& method = "pathtrace", int spp = 4) {
   auto s = Scene::build(d);
   RenderOptions o;
-  o.method = method;
+  o.method = *parseRenderMethod(method);
   o.spp = spp;
   o.maxSpp = spp;
   o.maxDepth = 4;

@@ -30,7 +30,7 @@ double analyticPixel(const Camera& cam, int x, int y) { return test::movingPlane
 
 RenderOptions photonOptions(const std::string& method) {
   RenderOptions o;
-  o.method = method;
+  o.method = *parseRenderMethod(method);
   o.spp = 16;
   o.seed = 11;
   o.causticPhotons = 0;
@@ -145,9 +145,9 @@ TEST_CASE("static scene: time and standard give identical images and no temporal
   o.causticPhotons = 20000;
   o.globalPhotons = 5000;
   RenderStats stTime, stStd;
-  o.method = "time";
+  o.method = RenderMethod::Time;
   Film a = renderWith(d, o, stTime);
-  o.method = "standard";
+  o.method = RenderMethod::Standard;
   Film b = renderWith(d, o, stStd);
   CHECK(bitIdentical(a, b));
   CHECK(stTime.timeEstimates == 0);
@@ -161,7 +161,7 @@ TEST_CASE("static scene: time and standard give identical images and no temporal
 TEST_CASE("time method: only eye paths that can meet motion use the time-dependent estimate") {
   auto d = smallCausticScene(true);
   RenderOptions o;
-  o.method = "time";
+  o.method = RenderMethod::Time;
   o.spp = 2;
   o.causticPhotons = 20000;
   o.globalPhotons = 5000;
@@ -179,7 +179,7 @@ TEST_CASE("adaptive sampling: pixels the moving object never crosses get the min
   auto d = test::blackSphereAcrossSky(32, 8, 12, 0.5f, 1.5f);
   auto s = Scene::build(d);
   RenderOptions o;
-  o.method = "pathtrace";
+  o.method = RenderMethod::PathTrace;
   o.spp = 16;
   o.maxSpp = 256;
   o.contrast = 0.02f;
@@ -226,7 +226,7 @@ TEST_CASE("determinism: every method gives bit-identical images on 1 and 2 threa
     for (bool fourD : {false, true}) {
       if (fourD && std::string(method) != "time") continue;
       RenderOptions o;
-      o.method = method;
+      o.method = *parseRenderMethod(method);
       o.spp = 2;
       o.maxSpp = 8;
       o.causticPhotons = 8000;

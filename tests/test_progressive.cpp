@@ -35,7 +35,7 @@ double analyticPixel(const Camera& cam, int x, int y) { return test::movingPlane
 // estimate alone, as in test_photon_render.cpp.
 RenderOptions planeOptions(const std::string& method, uint64_t seed) {
   RenderOptions o;
-  o.method = method;
+  o.method = *parseRenderMethod(method);
   o.progressive = true;
   o.spp = 2;
   o.seed = seed;
@@ -232,7 +232,7 @@ TEST_CASE("progressive: a point-light caustic on a moving floor converges to the
     float t = (f + 0.5f) / frames;
     auto s = Scene::build(causticScene(0.6f * t));
     RenderOptions o = causticOptions();
-    o.method = "static";
+    o.method = RenderMethod::Static;
     o.causticPhotons = 50000;
     o.estimate.k = 50;
     RenderStats st;
@@ -242,7 +242,7 @@ TEST_CASE("progressive: a point-light caustic on a moving floor converges to the
   }
   auto s = Scene::build(causticScene(-1.0f));
   RenderOptions o = causticOptions();
-  o.method = "time";
+  o.method = RenderMethod::Time;
   o.progressive = true;
   o.causticPhotons = 10000;
   o.estimate.k = 50;
@@ -310,7 +310,7 @@ TEST_CASE("progressive: pass kernels follow alpha, and the half window stops at 
   st.scalars["kernel.global.half_window_1"] = 1.1 / 256.0;  // 1.1 bins
   st.scalars["kernel.global.spatial_radius_1"] = 0.2;
   RenderOptions o;
-  o.method = "time";
+  o.method = RenderMethod::Time;
   for (float alpha : {0.0f, 0.5f}) {
     o.alpha = alpha;
     double a3 = alpha > 0 ? alpha : 4.0 / 7.0;
@@ -325,7 +325,7 @@ TEST_CASE("progressive: pass kernels follow alpha, and the half window stops at 
     CHECK(double(k.global.radius) * k.global.radius * k.global.halfWindow ==
           doctest::Approx(0.01 * s3 * s3 * (1.1 / 256.0) * s3).epsilon(1e-4));
   }
-  o.method = "standard";
+  o.method = RenderMethod::Standard;
   o.alpha = 0.5f;
   CHECK(kernelsForPass(st, o, *s, 9).caustic.spatialRadius == doctest::Approx(0.2 * kernelScale(9, 0.5, 2)));
 }

@@ -75,7 +75,7 @@ double regionMean(const Film& f, const std::vector<size_t>& region) {
 
 double renderMean(const Scene& s, const std::vector<size_t>& region, const std::string& method, int spp) {
   RenderOptions o;
-  o.method = method;
+  o.method = *parseRenderMethod(method);
   o.spp = spp;
   o.seed = 21;
   o.causticPhotons = 300000;

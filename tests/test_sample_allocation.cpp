@@ -50,7 +50,7 @@ scene::SceneDescription glassHighlight(int w, int h) {
 
 RenderOptions glassOptions(float extra) {
   RenderOptions o;
-  o.method = "time";
+  o.method = RenderMethod::Time;
   o.progressive = true;
   o.spp = 2;
   o.seed = 9;
@@ -212,7 +212,7 @@ TEST_CASE("sample allocation: adaptive passes on the moving plane converge to th
   // shutter: a little eye-side noise everywhere, photons seen directly.
   auto s = Scene::build(test::movingPlaneScene(8));
   RenderOptions o;
-  o.method = "time";
+  o.method = RenderMethod::Time;
   o.progressive = true;
   o.spp = 2;
   o.seed = 31;

@@ -208,7 +208,7 @@ TEST_CASE("sampler: a pixel's sample indices continue across adaptive batches") 
   // batch of 16, added in the same order: bit-identical images.
   auto s = Scene::build(cubeCaustic(12, 9));
   RenderOptions one, two;
-  one.method = two.method = "pathtrace";
+  one.method = two.method = RenderMethod::PathTrace;
   one.spp = 16;
   one.maxSpp = 16;
   two.spp = 8;
@@ -223,7 +223,7 @@ TEST_CASE("sampler: a pixel's sample indices continue across adaptive batches") 
 TEST_CASE("sampler: sobol and random agree in mean, and sobol's error is smaller on the cube caustic") {
   auto s = Scene::build(cubeCaustic(40, 30));
   RenderOptions o;
-  o.method = "pathtrace";
+  o.method = RenderMethod::PathTrace;
   o.spp = o.maxSpp = 256;
   RenderStats st;
   o.sampler = SamplerKind::Sobol;
@@ -247,7 +247,7 @@ TEST_CASE("adaptive sampling: unbiased on a caustic through glass, and cheaper o
   // non-adaptive image within 1% and within 4 sigma of their difference.
   auto s = Scene::build(cubeCaustic(40, 30, 5.0f));
   RenderOptions full;
-  full.method = "pathtrace";
+  full.method = RenderMethod::PathTrace;
   full.spp = full.maxSpp = 512;
   full.seed = 11;
   RenderStats stFull, stAd;

@@ -107,7 +107,7 @@ Agreement compareFilms(const Film& a, const Film& b) {
 
 void checkAgreement(const RenderOptions& o, const Film& ref, const Film& f, const std::string& what) {
   Agreement r = compareFilms(ref, f);
-  MESSAGE(o.method << " " << what << ": mean " << r.meanB << " vs " << r.meanA << " (ratio " << r.meanB / r.meanA
+  MESSAGE(renderMethodName(o.method) << " " << what << ": mean " << r.meanB << " vs " << r.meanA << " (ratio " << r.meanB / r.meanA
                    << ", sigma of the difference " << r.meanSigma << "); " << r.outliers << " of " << r.pixels
                    << " pixels beyond 5 sigma, worst " << r.worstSigmas << " sigma");
   CHECK(std::fabs(r.meanA - r.meanB) <= 4 * r.meanSigma + 1e-3 * r.meanA);
@@ -207,7 +207,7 @@ void checkExtremeScene(const std::string& what, const scene::SceneDescription& d
   for (const std::string& m : eo.methods) {
     INFO("method " << m);
     RenderOptions o;
-    o.method = m;
+    o.method = *parseRenderMethod(m);
     o.spp = 4;
     o.maxSpp = 8;
     o.seed = 5;
@@ -284,7 +284,7 @@ scene::SceneDescription baseScene(int w = 12, int h = 12) {
 
 TEST_CASE("stress: the same scene at 1e-3, 1 and 1e3 scale renders the same image (path tracer)") {
   RenderOptions o;
-  o.method = "pathtrace";
+  o.method = RenderMethod::PathTrace;
   o.spp = 32;
   o.seed = 3;
   checkScaleInvariance(o);
@@ -292,7 +292,7 @@ TEST_CASE("stress: the same scene at 1e-3, 1 and 1e3 scale renders the same imag
 
 TEST_CASE("stress: the same scene at 1e-3, 1 and 1e3 scale renders the same image (time method)") {
   RenderOptions o;
-  o.method = "time";
+  o.method = RenderMethod::Time;
   o.spp = 8;
   o.seed = 3;
   o.causticPhotons = 40000;
@@ -305,11 +305,11 @@ TEST_CASE("stress: the same scene at 1e-3, 1 and 1e3 scale renders the same imag
 
 TEST_CASE("stress: a floor of 1e7 and 1e8 around the scene renders what a floor of 100 does") {
   RenderOptions o;
-  o.method = "pathtrace";
+  o.method = RenderMethod::PathTrace;
   o.spp = 16;
   o.seed = 3;
   checkHugeFloor(o);
-  o.method = "time";
+  o.method = RenderMethod::Time;
   o.spp = 8;
   o.causticPhotons = 40000;
   o.globalPhotons = 20000;
@@ -400,7 +400,7 @@ namespace {
 // variance layers), reads it back and returns its non-finite values.
 size_t nonFiniteInExr(const scene::SceneDescription& d, const std::string& method, double& brightest) {
   RenderOptions o;
-  o.method = method;
+  o.method = *parseRenderMethod(method);
   o.spp = 4;
   o.maxSpp = 8;
   o.frames = 3;
@@ -477,7 +477,7 @@ TEST_CASE("stress: a zero-length shutter with the time method") {
   // 4D search on it too.
   auto s = Scene::build(d);
   RenderOptions o;
-  o.method = "time";
+  o.method = RenderMethod::Time;
   o.spaceTime4D = true;
   o.spp = 4;
   o.causticPhotons = 20000;
@@ -509,7 +509,7 @@ TEST_CASE("stress: a zero-power light gets a warning, as a scene with no lights 
     return false;
   };
   RenderOptions o;
-  o.method = "pathtrace";
+  o.method = RenderMethod::PathTrace;
   o.spp = 1;
   RenderStats st;
   renderScene(d, o, &st);

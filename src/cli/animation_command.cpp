@@ -20,6 +20,7 @@
 #include "cli/path_names.h"
 #include "dist/comm.h"
 #include "cli/progress_bar.h"
+#include "cli/render_metadata.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/signals.h"
@@ -153,45 +154,49 @@ std::string findOnPath(const std::string& name) {
   return "";
 }
 
-int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, const RenderOptions& opt,
-                 float exposure) {
-  Timer total;
-  const scene::AnimationDesc& anim = *descIn.animation;
-  // ---- everything that can be wrong, before any file is made ----
-  // Under mpirun every rank checks; an error is reported once by rank 0 and
-  // every rank exits 1 (dist::raiseIfAnyFailed).
-  dist::Comm& comm = dist::world();
-  FrameRange range{0, anim.frames - 1};
-  std::string pattern, ffmpeg, setupError;
+namespace {
+
+// Where the frames go: the range, every frame's EXR and PNG, and ffmpeg for --video.
+struct FrameOutputs {
+  FrameRange range;
+  std::string pattern, ffmpeg;
   std::vector<std::string> outputs, previews;
-  try {
-  if (a.frameRange) range = parseFrameRange(*a.frameRange, anim.frames);
-  pattern = a.output.empty() ? stemOf(a.scene) + (range.count() > 1 ? "_####.exr" : ".exr") : a.output;
-  checkFramePattern(pattern, range);
-  if (!animationSupportsMethod(opt.method))
-    throw Error("--method: '" + opt.method + "' cannot render an animation (use time, standard or pathtrace)");
+};
+
+// Everything that can be wrong with the frames' outputs, before any file is
+// made; then the output directories are created (only now). Throws tdpm::Error.
+void prepareFrameOutputs(const RenderArgs& a, const scene::AnimationDesc& anim, const RenderOptions& opt,
+                         FrameOutputs& f) {
+  f.range = FrameRange{0, anim.frames - 1};
+  if (a.frameRange) f.range = parseFrameRange(*a.frameRange, anim.frames);
+  f.pattern = a.output.empty() ? stemOf(a.scene) + (f.range.count() > 1 ? "_####.exr" : ".exr") : a.output;
+  checkFramePattern(f.pattern, f.range);
+  if (!renderMethodTraits(opt.method).animation)
+    throw Error("--method: '" + std::string(renderMethodName(opt.method)) +
+                "' cannot render an animation (use time, standard or pathtrace)");
   if (a.video) {
     if (!endsWith(*a.video, ".mp4") && !endsWith(*a.video, ".gif"))
       throw Error("--video: '" + *a.video + "' must end in .mp4 or .gif");
-    ffmpeg = findOnPath("ffmpeg");
-    if (ffmpeg.empty())
+    f.ffmpeg = findOnPath("ffmpeg");
+    if (f.ffmpeg.empty())
       throw Error("--video: ffmpeg was not found on PATH; install it (Debian: apt-get install ffmpeg) or leave out "
                   "--video (the PNG previews are written either way)");
   }
-  for (int i = range.first; i <= range.last; ++i) {
-    outputs.push_back(formatFramePath(pattern, i));
-    previews.push_back(image::previewPathFor(outputs.back()));
+  for (int i = f.range.first; i <= f.range.last; ++i) {
+    f.outputs.push_back(formatFramePath(f.pattern, i));
+    f.previews.push_back(image::previewPathFor(f.outputs.back()));
   }
   // Only now is anything created: the output directories.
-  for (size_t i = 0; i < outputs.size(); ++i) {
-    if (i == 0 || directoryOf(outputs[i]) != directoryOf(outputs[i - 1])) makeDirectories(directoryOf(outputs[i]), "--output");
+  for (size_t i = 0; i < f.outputs.size(); ++i) {
+    if (i == 0 || directoryOf(f.outputs[i]) != directoryOf(f.outputs[i - 1]))
+      makeDirectories(directoryOf(f.outputs[i]), "--output");
     try {
-      checkOutputPath(outputs[i]);
-      checkOutputPath(previews[i]);
+      checkOutputPath(f.outputs[i]);
+      checkOutputPath(f.previews[i]);
     } catch (const Error& e) {
       throw Error(std::string("--output: ") + e.what());
     }
-    for (const std::string* o : {&outputs[i], &previews[i]})
+    for (const std::string* o : {&f.outputs[i], &f.previews[i]})
       if (sameFile(*o, a.scene)) throw Error("--output: '" + *o + "' is the scene file '" + a.scene + "'");
   }
   if (a.video) {
@@ -202,6 +207,58 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
       throw Error(std::string("--video: ") + e.what());
     }
   }
+}
+
+// One written frame, for the summary.
+struct FrameLine {
+  int frame;
+  double seconds;
+  uint64_t samples;
+  int minSpp, maxSpp;
+};
+
+// Rank 0's lines once every frame is written: one per frame, the summary, --stats.
+void printAnimationSummary(const RenderArgs& a, const RenderOptions& opt, const FrameOutputs& f,
+                           const std::vector<FrameLine>& lines, const AnimationStats& stats, const Scene& scene,
+                           double allSeconds, uint64_t peakRss) {
+  if (!a.quiet) {
+    for (const FrameLine& l : lines)
+      std::fprintf(stderr, "tdpm: frame %d: %.2f s, %d-%d samples per pixel -> %s\n", l.frame, l.seconds, l.minSpp,
+                   l.maxSpp, f.outputs[size_t(l.frame - f.range.first)].c_str());
+    double all = allSeconds;
+    std::fprintf(stderr,
+                 "tdpm: %s, %s: %d frames (%d-%d) at %dx%d, %.2f s in all, %.2f s per frame; photons: %llu caustic, "
+                 "%llu global stored in %llu segments, %.2f s%s%s\n",
+                 a.scene.c_str(), renderMethodName(opt.method), f.range.count(), f.range.first, f.range.last,
+                 scene.camera.width(), scene.camera.height(), all, all / double(f.range.count()),
+                 static_cast<unsigned long long>(stats.causticStored),
+                 static_cast<unsigned long long>(stats.globalStored),
+                 static_cast<unsigned long long>(stats.segmentsTraced), stats.photonSeconds,
+                 a.video ? " -> video " : "", a.video ? a.video->c_str() : "");
+  }
+  if (a.stats) {
+    std::fprintf(stderr, "tdpm: stats:\n");
+    std::fprintf(stderr, "  peak resident memory: %llu bytes\n", static_cast<unsigned long long>(peakRss));
+    std::fprintf(stderr, "  peak photons held: %zu\n", stats.peakHeldPhotons);
+    std::fprintf(stderr, "  photon pass: %.3f s\n", stats.photonSeconds);
+  }
+}
+
+}  // namespace
+
+// One level: the outputs (every rank checks), this rank's block of frames
+// rendered and written, rank 0's video and summary.
+int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, const RenderOptions& opt,
+                 float exposure) {
+  Timer total;
+  const scene::AnimationDesc& anim = *descIn.animation;
+  // Under mpirun every rank checks; an error is reported once by rank 0 and
+  // every rank exits 1 (dist::raiseIfAnyFailed).
+  dist::Comm& comm = dist::world();
+  FrameOutputs f;
+  std::string setupError;
+  try {
+    prepareFrameOutputs(a, anim, opt, f);
   } catch (const Error& e) {
     if (!comm.distributed()) throw;
     setupError = e.what();
@@ -214,55 +271,32 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
   // process would), each rank writing its own frames; rank 0 prints and
   // assembles the video once every rank has finished (docs/distributed.md).
   uint64_t blockLo = 0, blockHi = 0;
-  dist::blockRange(uint64_t(range.count()), comm.rank(), comm.size(), blockLo, blockHi);
+  dist::blockRange(uint64_t(f.range.count()), comm.rank(), comm.size(), blockLo, blockHi);
   std::FILE* barStream = ProgressBar::stream(a.quiet, comm.distributed());  // none under mpirun
   ProgressBar bar(comm.root() && barStream, barStream ? barStream : stderr);
   auto scene = Scene::build(descIn);
   AnimationOptions ao;
-  ao.first = range.first + int(blockLo);
-  ao.last = range.first + int(blockHi) - 1;
+  ao.first = f.range.first + int(blockLo);
+  ao.last = f.range.first + int(blockHi) - 1;
   ao.window = a.window.value_or(ao.window);
   ao.independentFrames = a.independentFrames;
-  struct FrameLine {
-    int frame;
-    double seconds;
-    uint64_t samples;
-    int minSpp, maxSpp;
-  };
   std::vector<FrameLine> lines;
   uint64_t peakRss = 0;
   Timer frameTimer;
   AnimationStats stats;
   std::string frameError;
   try {
-  if (ao.first <= ao.last)
-  stats = renderAnimation(*scene, anim, opt, ao, bar.progress(), [&](int i, Film&& film, const RenderStats& st) {
-    size_t k = size_t(i - range.first);
-    image::ExrFile exr = filmToExr(std::move(film));
-    char seconds[32], shutter[64];
-    std::snprintf(seconds, sizeof seconds, "%.3f", st.seconds);
-    std::snprintf(shutter, sizeof shutter, "%.9g %.9g", anim.frameOpen(i), anim.frameClose(i));
-    exr.metadata = {{"tdpm/version", TDPM_VERSION},
-                    {"tdpm/scene", a.scene},
-                    {"tdpm/method", opt.method},
-                    {"tdpm/frame", std::to_string(i)},
-                    {"tdpm/frame_shutter", shutter},
-                    {"tdpm/spp", std::to_string(opt.spp)},
-                    {"tdpm/max_spp", std::to_string(opt.maxSpp)},
-                    {"tdpm/spp_taken", std::to_string(st.minSpp) + "-" + std::to_string(st.maxSpp)},
-                    {"tdpm/seed", std::to_string(opt.seed)},
-                    {"tdpm/sampler", samplerName(opt.sampler)},
-                    {"tdpm/max_depth", std::to_string(opt.maxDepth)},
-                    {"tdpm/render_seconds", seconds}};
-    if (opt.method != "pathtrace") {
-      exr.metadata["tdpm/caustic_photons"] = std::to_string(st.causticStored);
-      exr.metadata["tdpm/global_photons"] = std::to_string(st.globalStored);
-    }
-    writeRenderOutputs(outputs[k], previews[k], exr, exposure);
-    lines.push_back({i, frameTimer.seconds(), st.cameraSamples, st.minSpp, st.maxSpp});
-    frameTimer.reset();
-    peakRss = std::max(peakRss, st.peakResidentBytes);
-  });
+    if (ao.first <= ao.last)
+      stats = renderAnimation(*scene, anim, opt, ao, bar.progress(), [&](int i, Film&& film, const RenderStats& st) {
+        size_t k = size_t(i - f.range.first);
+        image::ExrFile exr = filmToExr(std::move(film));
+        const FrameTag tag{i, double(anim.frameOpen(i)), double(anim.frameClose(i))};
+        exr.metadata = renderMetadata(a.scene, opt, st, &tag);
+        writeRenderOutputs(f.outputs[k], f.previews[k], exr, exposure);
+        lines.push_back({i, frameTimer.seconds(), st.cameraSamples, st.minSpp, st.maxSpp});
+        frameTimer.reset();
+        peakRss = std::max(peakRss, st.peakResidentBytes);
+      });
   } catch (const Error& e) {
     if (!comm.distributed()) throw;
     frameError = e.what();
@@ -271,31 +305,11 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
   // any rank is reported once and every rank exits 1.
   dist::raiseIfAnyFailed(comm, frameError);
   if (!comm.root()) return 0;
-  if (a.video) assembleVideo(ffmpeg, *a.video, previews, anim.fps);
+  if (a.video) assembleVideo(f.ffmpeg, *a.video, f.previews, anim.fps);
   bar.finish();
   for (const std::string& w : stats.warnings) std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
   peakRss = std::max(peakRss, peakResidentBytes());
-  if (!a.quiet) {
-    for (const FrameLine& l : lines)
-      std::fprintf(stderr, "tdpm: frame %d: %.2f s, %d-%d samples per pixel -> %s\n", l.frame, l.seconds, l.minSpp,
-                   l.maxSpp, outputs[size_t(l.frame - range.first)].c_str());
-    double all = total.seconds();
-    std::fprintf(stderr,
-                 "tdpm: %s, %s: %d frames (%d-%d) at %dx%d, %.2f s in all, %.2f s per frame; photons: %llu caustic, "
-                 "%llu global stored in %llu segments, %.2f s%s%s\n",
-                 a.scene.c_str(), opt.method.c_str(), range.count(), range.first, range.last, scene->camera.width(),
-                 scene->camera.height(), all, all / double(range.count()),
-                 static_cast<unsigned long long>(stats.causticStored),
-                 static_cast<unsigned long long>(stats.globalStored),
-                 static_cast<unsigned long long>(stats.segmentsTraced), stats.photonSeconds,
-                 a.video ? " -> video " : "", a.video ? a.video->c_str() : "");
-  }
-  if (a.stats) {
-    std::fprintf(stderr, "tdpm: stats:\n");
-    std::fprintf(stderr, "  peak resident memory: %llu bytes\n", static_cast<unsigned long long>(peakRss));
-    std::fprintf(stderr, "  peak photons held: %zu\n", stats.peakHeldPhotons);
-    std::fprintf(stderr, "  photon pass: %.3f s\n", stats.photonSeconds);
-  }
+  printAnimationSummary(a, opt, f, lines, stats, *scene, total.seconds(), peakRss);
   return 0;
 }
 

@@ -68,7 +68,7 @@ void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& s
   // Nobody said: a scene rendered with its own photon method renders in passes.
   const bool byDefault = defaultAllowed && !a.method && !a.fixedBudget && !sc.progressive.has_value();
   const bool sceneAsks = !a.fixedBudget && sc.progressive.value_or(byDefault);
-  const bool sceneApplies = sceneAsks && isProgressiveMethod(o.method);
+  const bool sceneApplies = sceneAsks && renderMethodTraits(o.method).progressive;
   o.progressive = a.progressive || sceneApplies;
   if (!o.progressive) {
     // --fixed-budget (or a method without passes) overrides a scene that asks
@@ -86,8 +86,9 @@ void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& s
       throw Error("render.time_limit in " + sourcePath + " needs render.progressive true or --progressive");
     return;
   }
-  if (!isProgressiveMethod(o.method))
-    throw Error("--progressive works with the methods time, accumulation and standard, not '" + o.method +
+  if (!renderMethodTraits(o.method).progressive)
+    throw Error("--progressive works with the methods time, accumulation and standard, not '" +
+                std::string(renderMethodName(o.method)) +
                 "' (set by " + (a.method ? std::string("--method") : "render.method in " + sourcePath + " or the default") + ")");
   // Settings a progressive render does not use: a flag is an error (the
   // user asked for something that would not happen), a scene key a note
@@ -103,7 +104,7 @@ void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& s
          "(--extra-samples); more passes take more");
   // Named by the method in use: -m time was told about "accumulation --progressive" (issue 27 item 16).
   unused(bool(a.frames), bool(sc.frames), "--frames", "frames",
-         o.method == "accumulation"
+         renderMethodTraits(o.method).inBetweenFrames
              ? "passes replace in-between frames: accumulation --progressive renders one stratified time per pass"
              : "only the accumulation method renders in-between frames");
   unused(a.search && *a.search == "4d", sc.search && *sc.search == "4d", "--search 4d", "search",

@@ -12,7 +12,7 @@
 #include "cli/render_command.h"
 #include "core/progress.h"
 #include "render/progressive_state.h"
-#include "render/renderer.h"
+#include "render/render_options.h"
 #include "scene/description.h"
 #include "scene/limits.h"
 

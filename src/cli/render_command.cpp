@@ -21,6 +21,7 @@
 #include "cli/path_names.h"
 #include "cli/progress_bar.h"
 #include "cli/rank_agreement.h"
+#include "cli/render_metadata.h"
 #include "cli/resume.h"
 #include "render/progressive_io.h"
 #include "cli/progressive_options.h"
@@ -49,11 +50,7 @@ namespace {
 namespace limits = scene::limits;
 static_assert(limits::kTimeBins == photon::kTimeBins, "the kappa range in scene/limits.h assumes the photon time bins");
 
-std::string methodList() {
-  std::string s;
-  for (const char* const* m = renderMethods(); *m; ++m) s += std::string(s.empty() ? "" : " | ") + *m;
-  return s;
-}
+std::string methodList() { return renderMethodList(); }
 
 // pbrt's Film "filename" (often .exr, .png or .pfm): tdpm writes EXR, so
 // the name keeps its directory and stem and gets the .exr extension.
@@ -206,7 +203,10 @@ estimate::TimeKernel timeKernelFrom(const std::string& s) {
 // Merges flags over the scene's settings over the renderer's defaults.
 RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath) {
   RenderOptions o;
-  o.method = pick(a.method, sc.method, o.method);
+  // Both names were checked (runRender, scene/parse): this is the one parse.
+  const std::string methodName = pick(a.method, sc.method, std::string(renderMethodName(o.method)));
+  if (std::optional<RenderMethod> m = parseRenderMethod(methodName)) o.method = *m;
+  else throw Error("--method: unknown method '" + methodName + "' (expected " + methodList() + ")");
   o.spp = pick(a.spp, sc.spp, o.spp);
   o.maxSpp = pick(a.maxSpp, sc.maxSpp, o.spp);
   o.contrast = pick(a.contrast, sc.contrast, o.contrast);
@@ -254,7 +254,7 @@ std::vector<std::string> accumulationSppWarnings(const RenderOptions& o, bool ha
   std::vector<std::string> w;
   // A progressive accumulation renders one time per pass, not frames (issue
   // 27 item 16: it warned of "8 frames" while 2 passes took 2 spp).
-  if (o.method != "accumulation" || o.progressive || !hasMotion || o.frames <= 1) return w;
+  if (!renderMethodTraits(o.method).inBetweenFrames || o.progressive || !hasMotion || o.frames <= 1) return w;
   int batch = std::max(1, o.spp / o.frames);
   int maxBatch = std::max(batch, std::max(o.spp, o.maxSpp) / o.frames);
   if (batch * o.frames != o.spp || (o.maxSpp > o.spp && maxBatch * o.frames != o.maxSpp))
@@ -270,7 +270,7 @@ std::vector<std::string> accumulationSppWarnings(const RenderOptions& o, bool ha
 // After the render: every frame's photon pass emits at least one batch of
 // paths, so many frames with few photons each store more than asked.
 void warnAccumulationPhotons(const RenderOptions& o, bool hasMotion, const RenderStats& st) {
-  if (o.method != "accumulation" || o.progressive) return;
+  if (!renderMethodTraits(o.method).inBetweenFrames || o.progressive) return;
   const int frames = hasMotion ? std::max(1, o.frames) : 1;
   auto check = [&](const char* kind, size_t asked, size_t stored) {
     if (asked > 0 && double(stored) > 1.1 * double(asked))
@@ -289,6 +289,9 @@ RenderOptions renderOptionsFor(const RenderArgs& a, const scene::SceneDescriptio
   return mergeOptions(a, desc.render, a.scene);
 }
 
+// The flag table, one statement per flag in --help order: longer than 80
+// lines on purpose (it holds no logic; splitting it would only scatter the
+// help text).
 CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   CLI::App* c = app.add_subcommand("render", "Render a scene file to an OpenEXR image and a PNG preview");
   c->add_option("scene", a.scene, "Scene file: JSON (docs/scene-format.md) or pbrt-v3/v4 by the .pbrt extension (docs/pbrt-import.md)")->required();
@@ -387,30 +390,46 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   return c;
 }
 
-int runRender(const RenderArgs& a) {
-  Timer total;
-  // Under mpirun every rank loads and checks everything itself; an error on
-  // any rank stops every rank before work starts, reported once
-  // (dist::raiseIfAnyFailed). Rank 0 alone checks and writes the outputs,
-  // prints progress, warnings and the summary.
-  dist::Comm& comm = dist::world();
-  const bool pbrtScene = pbrt::isPbrtPath(a.scene);
-  std::string output = a.output.empty() ? stemOf(a.scene) + ".exr" : a.output;
-  std::string preview = image::previewPathFor(output);
+namespace {
+
+// What a render needs once its input is read and checked: the output names,
+// the scene (description and built), the merged options and the exposure.
+struct RenderSetup {
+  std::string output, preview;
   scene::SceneDescription desc;
   RenderOptions opt;
   float exposure = 0.0f;
   std::unique_ptr<Scene> scene;
-  std::string setupError;
-  const bool framePattern = hasFramePlaceholder(a.output);
-  try {
-  if (a.method && !isRenderMethod(*a.method))
+};
+
+// --kappa against the scene's shutter (the usable range depends on it,
+// scene/limits.h).
+void checkKappa(const RenderArgs& a, const scene::SceneDescription& desc) {
+  if (!a.kappa) return;
+  const double shutterLength = desc.animation ? desc.animation->shutterLength()
+                                              : double(desc.camera.shutterClose) - desc.camera.shutterOpen;
+  limits::KappaRange r = limits::kappaRange(shutterLength);
+  if (!(*a.kappa >= r.lo && *a.kappa <= r.hi)) {
+    char msg[200];
+    std::snprintf(msg, sizeof msg, "--kappa: %g cannot be used with the %g s shutter of ", double(*a.kappa),
+                  shutterLength);
+    throw Error(msg + a.scene + ": the 4D metric needs kappa in [" + limits::boundText(r.lo, true, true) + ", " +
+                limits::boundText(r.hi, false, true) + "] (float range)");
+  }
+}
+
+// Reads the scene (JSON or pbrt), checks every flag and the output location
+// before any work, merges the options and builds the scene. Throws
+// tdpm::Error; every rank runs it (rank 0 alone checks the outputs).
+void loadRenderSetup(const RenderArgs& a, dist::Comm& comm, bool framePattern, RenderSetup& s) {
+  const bool pbrtScene = pbrt::isPbrtPath(a.scene);
+  if (a.method && !parseRenderMethod(*a.method))
     throw Error("--method: unknown method '" + *a.method + "' (expected " + methodList() + ")");
   int width = 0, height = 0;
   if (a.resolution) parseResolution(*a.resolution, width, height);
   // A pbrt scene names its own output (Film "filename"), known only once it is read.
   // A frame pattern (out/frame_####.exr) is checked once the frames are known.
-  if (comm.root() && (!pbrtScene || !a.output.empty()) && !framePattern) validateOutput(output, preview, a.scene);
+  if (comm.root() && (!pbrtScene || !a.output.empty()) && !framePattern) validateOutput(s.output, s.preview, a.scene);
 
   std::map<std::string, std::string> settingSources;  // pbrt: where derived render settings came from
   if (pbrtScene) {
@@ -418,86 +437,68 @@ int runRender(const RenderArgs& a) {
     if (comm.root())
       for (const std::string& n : imported.notes) std::fprintf(stderr, "tdpm: note: %s\n", n.c_str());
     if (a.output.empty()) {
-      if (imported.filmFilename) output = exrNameForFilm(*imported.filmFilename);
-      preview = image::previewPathFor(output);
-      if (comm.root()) validateOutput(output, preview, a.scene);
+      if (imported.filmFilename) s.output = exrNameForFilm(*imported.filmFilename);
+      s.preview = image::previewPathFor(s.output);
+      if (comm.root()) validateOutput(s.output, s.preview, a.scene);
     }
     // An Include or PLY mesh named like the output is an input too.
     if (comm.root() && !framePattern)
       for (const std::string& f : std::set<std::string>(imported.inputFiles.begin(), imported.inputFiles.end()))
-        refuseOverwritingInput(output, preview, f, "a file the scene reads");
-    desc = std::move(imported.scene);
+        refuseOverwritingInput(s.output, s.preview, f, "a file the scene reads");
+    s.desc = std::move(imported.scene);
     settingSources = std::move(imported.settingSources);
   } else {
-    desc = scene::loadScene(a.scene);
+    s.desc = scene::loadScene(a.scene);
   }
   dist::testFailurePoint(comm, "load");
-  if (a.kappa) {
-    // The usable kappa depends on the scene's shutter (scene/limits.h).
-    const double shutterLength = desc.animation ? desc.animation->shutterLength()
-                                                : double(desc.camera.shutterClose) - desc.camera.shutterOpen;
-    limits::KappaRange r = limits::kappaRange(shutterLength);
-    if (!(*a.kappa >= r.lo && *a.kappa <= r.hi)) {
-      char msg[200];
-      std::snprintf(msg, sizeof msg, "--kappa: %g cannot be used with the %g s shutter of ", double(*a.kappa),
-                    shutterLength);
-      throw Error(msg + a.scene + ": the 4D metric needs kappa in [" + limits::boundText(r.lo, true, true) + ", " +
-                  limits::boundText(r.hi, false, true) +
-                  "] (float range)");
-    }
-  }
+  checkKappa(a, s.desc);
   if (comm.root())
-    for (const scene::ObjectDesc& o : desc.objects)
+    for (const scene::ObjectDesc& o : s.desc.objects)
       if (o.shape.type == scene::ShapeDesc::Type::Mesh)
-        refuseOverwritingInput(output, preview, o.shape.meshFile, "the mesh file of object '" + o.name + "'");
-  opt = mergeOptions(a, desc.render, a.scene);
+        refuseOverwritingInput(s.output, s.preview, o.shape.meshFile, "the mesh file of object '" + o.name + "'");
+  s.opt = mergeOptions(a, s.desc.render, a.scene);
   // A pbrt scene's photon count comes from a statement, not a JSON key.
-  if (!a.photons && settingSources.count("photons")) opt.causticPhotonsSource = settingSources["photons"];
+  if (!a.photons && settingSources.count("photons")) s.opt.causticPhotonsSource = settingSources["photons"];
   // Passes by default where they are available: not for an animation's frames.
-  mergeProgressiveOptions(a, desc.render, a.scene, opt, !desc.animation, comm.root());
-  checkResumeFlags(a.resume ? &*a.resume : nullptr, opt.progressive);
-  exposure = pick(a.exposure, desc.render.exposure, 0.0f);
+  mergeProgressiveOptions(a, s.desc.render, a.scene, s.opt, !s.desc.animation, comm.root());
+  checkResumeFlags(a.resume ? &*a.resume : nullptr, s.opt.progressive);
+  s.exposure = pick(a.exposure, s.desc.render.exposure, 0.0f);
   if (a.resolution) {
-    desc.camera.width = width;
-    desc.camera.height = height;
-    opt.resolutionSource = "--resolution " + *a.resolution;
+    s.desc.camera.width = width;
+    s.desc.camera.height = height;
+    s.opt.resolutionSource = "--resolution " + *a.resolution;
   } else {
-    opt.resolutionSource = "camera.resolution in " + a.scene;
+    s.opt.resolutionSource = "camera.resolution in " + a.scene;
   }
-  scene = Scene::build(desc);
+  s.scene = Scene::build(s.desc);
+}
+
+// A progressive render starts from the state --resume names (checked
+// against this scene and these options before any work) or from an empty
+// one with this render's fingerprint (cli/resume.h); the pass loop
+// updates it and the output EXR carries it (docs/resume.md).
+ProgressiveState startProgressiveState(const RenderArgs& a, const RenderSetup& s, dist::Comm& comm) {
+  ProgressiveState state;
+  if (!s.opt.progressive) return state;
+  // Not yet run per frame (every rank sees the same scene: an agreed error).
+  if (s.desc.animation)
+    throw dist::AgreedError("--progressive: an animation's frames are rendered with a fixed photon budget; progressive frames are "
+                "not supported yet (leave out --progressive, or render.progressive in " + a.scene + ")");
+  // Under mpirun rank 0 alone reads --resume and holds the state; the
+  // pass loop sends the others what they need (render/progressive.h).
+  std::string resumeError;
+  try {
+    if (comm.root()) state = initialProgressiveState(a.resume ? &*a.resume : nullptr, s.desc, s.opt);
   } catch (const Error& e) {
     if (!comm.distributed()) throw;
-    setupError = e.what();
+    resumeError = e.what();
   }
-  dist::raiseIfAnyFailed(comm, setupError);
-  // Under mpirun: the same scene and options on every rank, or one error
-  // before any collective whose shape depends on them (cli/rank_agreement.h).
-  requireRanksAgree(comm, comm.distributed() ? rankSettings(a, desc, opt, exposure) : std::map<std::string, std::string>{},
-                    a.scene);
+  dist::raiseIfAnyFailed(comm, resumeError);
+  return state;
+}
 
-  // A progressive render starts from the state --resume names (checked
-  // against this scene and these options before any work) or from an empty
-  // one with this render's fingerprint (cli/resume.h); the pass loop
-  // updates it and the output EXR carries it (docs/resume.md).
-  ProgressiveState progressiveState;
-  if (opt.progressive) {
-    // Not yet run per frame (every rank sees the same scene: an agreed error).
-    if (desc.animation)
-      throw dist::AgreedError("--progressive: an animation's frames are rendered with a fixed photon budget; progressive frames are "
-                  "not supported yet (leave out --progressive, or render.progressive in " + a.scene + ")");
-    // Under mpirun rank 0 alone reads --resume and holds the state; the
-    // pass loop sends the others what they need (render/progressive.h).
-    std::string resumeError;
-    try {
-      if (comm.root()) progressiveState = initialProgressiveState(a.resume ? &*a.resume : nullptr, desc, opt);
-    } catch (const Error& e) {
-      if (!comm.distributed()) throw;
-      resumeError = e.what();
-    }
-    dist::raiseIfAnyFailed(comm, resumeError);
-  }
-
-  if (desc.animation) return runAnimation(a, desc, opt, exposure);
+// The animation flags on a scene without an animation block.
+void refuseAnimationFlags(const RenderArgs& a, bool framePattern) {
   if (framePattern || a.frameRange || a.video || a.window || a.independentFrames)
     throw Error(std::string(framePattern ? "--output: a frame-number pattern (#)"
                             : a.frameRange ? "--frame-range"
@@ -505,71 +506,47 @@ int runRender(const RenderArgs& a) {
                             : a.window     ? "--window"
                                            : "--independent-frames") +
                 " needs an animation, but " + a.scene + " has no \"animation\" block (docs/scene-format.md)");
+}
 
-  ThreadLimit limit(a.threads);
-  // Under mpirun no bar (ProgressBar::stream): progressive renders print a
-  // line per pass instead.
+// The render itself, fixed budget or progressive, with the progress bar
+// (rank 0) and the stop signals of a progressive render.
+Film renderImage(const RenderArgs& a, const RenderSetup& s, ProgressiveState& state, RenderStats& stats,
+                 dist::Comm& comm) {
+  const RenderOptions& opt = s.opt;
+  // Under mpirun no bar (ProgressBar::stream): a rank's stdout is a pty
+  // whatever mpirun's output is, so the bar went into redirected logs;
+  // progressive renders print a line per pass instead.
   std::FILE* barStream = ProgressBar::stream(a.quiet, comm.distributed());
   ProgressBar bar(comm.root() && barStream, barStream ? barStream : stderr);
   if (comm.root())
-    for (const std::string& w : accumulationSppWarnings(opt, scene->hasMotion))
+    for (const std::string& w : accumulationSppWarnings(opt, s.scene->hasMotion))
       std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
-  RenderStats stats;
   // Progressive: the first SIGINT/SIGTERM/SIGHUP/SIGUSR1 ends the loop after the
   // current pass and the passes done are written; a second one aborts. Under
   // mpirun all but SIGUSR1 drop the round in flight (render/progressive.cpp).
   if (opt.progressive) signals::setMode(signals::Mode::Stop);
   signals::setStopNotice(comm.root());
   bool passLines = opt.progressive && !a.quiet && !barStream;
-  Film film = opt.progressive ? renderProgressive(*scene, opt, progressiveState,
+  Film film = opt.progressive ? renderProgressive(*s.scene, opt, state,
                                                   passLines ? withPassLines(bar.progress()) : bar.progress(), stats,
                                                   comm)
-                              : render(*scene, opt, bar.progress(), stats, comm);
+                              : render(*s.scene, opt, bar.progress(), stats, comm);
   bar.finish();
-  // --stats: every rank's communication, gathered before rank 0 writes.
-  std::vector<RankSeconds> ranks = gatherRankStats(comm, stats.seconds);
-  if (!comm.root()) return 0;
-  for (const std::string& w : stats.warnings) std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
-  warnAccumulationPhotons(opt, scene->hasMotion, stats);
+  return film;
+}
 
-  const int filmWidth = film.width, filmHeight = film.height;
-  image::ExrFile exr = filmToExr(std::move(film));  // moved: the write path holds no second film
-  char seconds[32];
-  std::snprintf(seconds, sizeof seconds, "%.3f", stats.seconds);
-  exr.metadata = {{"tdpm/version", TDPM_VERSION},
-                  {"tdpm/scene", a.scene},
-                  {"tdpm/method", opt.method},
-                  {"tdpm/spp", std::to_string(opt.spp)},
-                  {"tdpm/max_spp", std::to_string(opt.maxSpp)},
-                  {"tdpm/spp_taken", std::to_string(stats.minSpp) + "-" + std::to_string(stats.maxSpp)},
-                  {"tdpm/seed", std::to_string(opt.seed)},
-                  {"tdpm/sampler", samplerName(opt.sampler)},
-                  {"tdpm/filter", filterName(opt.filter)},
-                  {"tdpm/max_depth", std::to_string(opt.maxDepth)},
-                  {"tdpm/render_seconds", seconds}};
-  bool photonMethod = opt.method != "pathtrace";
-  if (!photonMethod) exr.metadata["tdpm/caustic_guiding"] = formatG(opt.causticGuiding);
-  if (photonMethod) {
-    exr.metadata["tdpm/caustic_photons"] = std::to_string(stats.causticStored);
-    exr.metadata["tdpm/global_photons"] = std::to_string(stats.globalStored);
-    if (opt.method == "time") exr.metadata["tdpm/search"] = opt.spaceTime4D ? "4d" : "twopass";
-    if (opt.method == "accumulation" && !opt.progressive) exr.metadata["tdpm/frames"] = std::to_string(opt.frames);
-    if (opt.progressive) addProgressiveMetadata(progressiveState, exr.metadata);
-  }
-  // The state a later --resume continues from rides in the EXR (docs/resume.md).
-  const int passesDone = progressiveState.passesDone;
-  const std::string progressiveSummaryText = opt.progressive ? progressiveSummary(progressiveState) : std::string();
-  if (opt.progressive) addProgressiveState(std::move(progressiveState), exr);
-  writeRenderOutputs(output, preview, exr, exposure);  // both files or neither
-  stats.peakResidentBytes = peakResidentBytes();      // --stats: the write path included
-
+// Rank 0's lines after the image is written: the summary, the photons, the
+// progressive passes, a stop by a signal, and --stats.
+void printRenderSummary(const RenderArgs& a, const RenderSetup& s, const RenderStats& stats, int filmWidth,
+                        int filmHeight, double totalSeconds, const std::string& progressiveSummaryText, int passesDone,
+                        const std::vector<RankSeconds>& ranks, int rankCount) {
   if (!a.quiet) {
-    std::string ranksNote = comm.distributed() ? " on " + std::to_string(comm.size()) + " ranks" : std::string();
+    std::string ranksNote = rankCount > 1 ? " on " + std::to_string(rankCount) + " ranks" : std::string();
     std::fprintf(stderr, "tdpm: %s, %s%s: %dx%d, %s camera samples (%d-%d per pixel), %.2f s in all -> %s (preview %s)\n",
-                 a.scene.c_str(), opt.method.c_str(), ranksNote.c_str(), filmWidth, filmHeight,
-                 formatCount(stats.cameraSamples).c_str(), stats.minSpp, stats.maxSpp, total.seconds(), output.c_str(),
-                 preview.c_str());
-    if (photonMethod)
+                 a.scene.c_str(), renderMethodName(s.opt.method), ranksNote.c_str(), filmWidth, filmHeight,
+                 formatCount(stats.cameraSamples).c_str(), stats.minSpp, stats.maxSpp, totalSeconds, s.output.c_str(),
+                 s.preview.c_str());
+    if (renderMethodTraits(s.opt.method).photonMaps)
       std::fprintf(stderr,
                    "tdpm: photons: %s caustic (%s emitted), %s global (%s emitted), %.1f bytes each, %.2f s; "
                    "estimates: %llu time-dependent, %llu standard\n",
@@ -587,11 +564,68 @@ int runRender(const RenderArgs& a) {
                  : sig == SIGHUP  ? "SIGHUP"
                  : sig == SIGUSR1 ? "SIGUSR1"
                                   : "a signal",
-                 passesDone, passesDone, output.c_str());
+                 passesDone, passesDone, s.output.c_str());
   if (a.stats) {
     printStats(stats);
     printRankStats(ranks);
   }
+}
+
+}  // namespace
+
+// One level: set-up (every rank, errors agreed), the animation or the one
+// image, rank 0's outputs and summary.
+int runRender(const RenderArgs& a) {
+  Timer total;
+  // Under mpirun every rank loads and checks everything itself; an error on
+  // any rank stops every rank before work starts, reported once
+  // (dist::raiseIfAnyFailed). Rank 0 alone checks and writes the outputs,
+  // prints progress, warnings and the summary.
+  dist::Comm& comm = dist::world();
+  RenderSetup s;
+  s.output = a.output.empty() ? stemOf(a.scene) + ".exr" : a.output;
+  s.preview = image::previewPathFor(s.output);
+  std::string setupError;
+  const bool framePattern = hasFramePlaceholder(a.output);
+  try {
+    loadRenderSetup(a, comm, framePattern, s);
+  } catch (const Error& e) {
+    if (!comm.distributed()) throw;
+    setupError = e.what();
+  }
+  dist::raiseIfAnyFailed(comm, setupError);
+  // Under mpirun: the same scene and options on every rank, or one error
+  // before any collective whose shape depends on them (cli/rank_agreement.h).
+  requireRanksAgree(comm,
+                    comm.distributed() ? rankSettings(a, s.desc, s.opt, s.exposure) : std::map<std::string, std::string>{},
+                    a.scene);
+  ProgressiveState progressiveState = startProgressiveState(a, s, comm);
+
+  if (s.desc.animation) return runAnimation(a, s.desc, s.opt, s.exposure);
+  refuseAnimationFlags(a, framePattern);
+
+  ThreadLimit limit(a.threads);
+  RenderStats stats;
+  Film film = renderImage(a, s, progressiveState, stats, comm);
+  // --stats: every rank's communication, gathered before rank 0 writes.
+  std::vector<RankSeconds> ranks = gatherRankStats(comm, stats.seconds);
+  if (!comm.root()) return 0;
+  for (const std::string& w : stats.warnings) std::fprintf(stderr, "tdpm: warning: %s\n", w.c_str());
+  warnAccumulationPhotons(s.opt, s.scene->hasMotion, stats);
+
+  const int filmWidth = film.width, filmHeight = film.height;
+  image::ExrFile exr = filmToExr(std::move(film));  // moved: the write path holds no second film
+  exr.metadata = renderMetadata(a.scene, s.opt, stats);
+  if (renderMethodTraits(s.opt.method).photonMaps && s.opt.progressive)
+    addProgressiveMetadata(progressiveState, exr.metadata);
+  // The state a later --resume continues from rides in the EXR (docs/resume.md).
+  const int passesDone = progressiveState.passesDone;
+  const std::string progressiveSummaryText = s.opt.progressive ? progressiveSummary(progressiveState) : std::string();
+  if (s.opt.progressive) addProgressiveState(std::move(progressiveState), exr);
+  writeRenderOutputs(s.output, s.preview, exr, s.exposure);  // both files or neither
+  stats.peakResidentBytes = peakResidentBytes();              // --stats: the write path included
+  printRenderSummary(a, s, stats, filmWidth, filmHeight, total.seconds(), progressiveSummaryText, passesDone, ranks,
+                     comm.distributed() ? comm.size() : 1);
   return 0;
 }
 

@@ -8,7 +8,7 @@
 #include <optional>
 #include <string>
 
-#include "render/renderer.h"
+#include "render/render_options.h"
 #include "scene/description.h"
 
 namespace tdpm::cli {

@@ -100,8 +100,6 @@ std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments,
 
 }  // namespace
 
-bool animationSupportsMethod(const std::string& m) { return m == "time" || m == "standard" || m == "pathtrace"; }
-
 Shutter frameShutter(const scene::AnimationDesc& a, int frame) {
   return Shutter{float(a.frameOpen(frame)), float(a.frameClose(frame))};
 }
@@ -149,17 +147,18 @@ TimeGrid makeTimeGrid(const scene::AnimationDesc& a, double reach) {
 
 AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& anim, const RenderOptions& opt,
                                const AnimationOptions& ao, const Progress& progress, const FrameSink& sink) {
-  if (!animationSupportsMethod(opt.method))
-    throw Error("method '" + opt.method + "' cannot render an animation (use time, standard or pathtrace)");
+  const RenderMethodTraits& method = renderMethodTraits(opt.method);
+  if (!method.animation)
+    throw Error("method '" + std::string(method.name) + "' cannot render an animation (use time, standard or pathtrace)");
   TDPM_ASSERT(ao.first >= 0 && ao.last < anim.frames && ao.first <= ao.last && ao.window >= 1, "bad frame range");
   AnimationStats stats;
   const double shutter = anim.shutterLength();
   const double reach = std::isfinite(opt.estimate.maxTimeDistance) ? opt.estimate.maxTimeDistance / shutter
                                                                      : double(opt.maxDtFraction);
   const TimeGrid grid = makeTimeGrid(anim, reach);
-  const bool photons = opt.method != "pathtrace";
+  const bool photons = method.photonMaps;
   const bool wantGlobal = opt.visualizeGlobal || opt.gatherRays > 0;
-  const bool spaceTime = opt.spaceTime4D && opt.method == "time" && scene.hasMotion;
+  const bool spaceTime = opt.spaceTime4D && method.timeDependentEstimate && scene.hasMotion;  // the 4D tree serves it alone
   const size_t total = size_t(ao.last - ao.first + 1);
   // A window wider than the frames rendered holds nothing more (issue 27
   // item 15: one frame with --window 100000 was budgeted for 100002 frames'

@@ -70,7 +70,4 @@ AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& a
                                const AnimationOptions& animationOptions, const Progress& progress,
                                const FrameSink& sink);
 
-// The methods renderAnimation accepts, for messages.
-bool animationSupportsMethod(const std::string& method);
-
 }  // namespace tdpm

@@ -64,7 +64,7 @@ const char* timeKernelName(estimate::TimeKernel k) {
 std::map<std::string, std::string> renderSettings(const RenderOptions& o, int width, int height) {
   const estimate::Options& e = o.estimate;
   std::map<std::string, std::string> s = {
-      {"method", o.method},
+      {"method", renderMethodName(o.method)},
       {"seed", std::to_string(o.seed)},
       {"sampler", samplerName(o.sampler)},
       {"spp", std::to_string(o.spp)},

@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "photon/tracer.h"
+#include "render/photon_map.h"
 
 namespace tdpm {
 
@@ -29,15 +30,16 @@ struct PhotonCounts {
 
 PhotonCounts photonCounts(const Scene& scene, const RenderOptions& opt) {
   PhotonCounts p;
-  if (opt.method == "pathtrace" || scene.lights.empty()) return p;
+  const RenderMethodTraits& method = renderMethodTraits(opt.method);
+  if (!method.photonMaps || scene.lights.empty()) return p;
   p.caustic = photon::sceneHasSpecular(scene) ? opt.causticPhotons : 0;
-  p.global = opt.visualizeGlobal || opt.gatherRays > 0 ? opt.globalPhotons : 0;
-  if (opt.method == "accumulation") {
+  p.global = wantsGlobalMap(opt) ? opt.globalPhotons : 0;
+  if (method.inBetweenFrames) {
     size_t frames = size_t(scene.hasMotion ? std::max(1, opt.frames) : 1);
     p.caustic = (p.caustic + frames - 1) / frames;
     p.global = (p.global + frames - 1) / frames;
   } else {
-    p.spaceTime = opt.spaceTime4D && opt.method != "static" && scene.hasMotion;
+    p.spaceTime = opt.spaceTime4D && method.spreadsPhotonsInTime && scene.hasMotion;
   }
   return p;
 }
@@ -50,7 +52,7 @@ MemoryEstimate estimateRenderMemory(const Scene& scene, const RenderOptions& opt
   MemoryEstimate e;
   e.pixels = uint64_t(std::max(0, scene.camera.width())) * uint64_t(std::max(0, scene.camera.height()));
   // accumulation keeps the result, the running sum and the current frame.
-  const uint64_t films = opt.method == "accumulation" && scene.hasMotion && opt.frames > 1 ? 3 : 1;
+  const uint64_t films = renderMethodTraits(opt.method).inBetweenFrames && scene.hasMotion && opt.frames > 1 ? 3 : 1;
   e.films = films * kFilmBytesPerPixel * e.pixels;
   e.sampler = kSamplerBytesPerPixel * e.pixels;  // one film is sampled at a time
   e.samples = uint64_t(std::max(1, threads)) * uint64_t(std::max(1, opt.spp)) * kSampleBytes;

@@ -174,6 +174,9 @@ Rgb PhotonIntegrator::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampl
 // steel post of scenes/glass-ball.json reflected the floor grainy). Light
 // reached from the metal through mirrors or glass is a caustic on the
 // metal, already counted, so it is not added again.
+// Longer than 80 lines on purpose: it is the eye path of one sample, the
+// render's inner loop, and its running sums (L, eyeL, the branch's) and
+// throughput stay local to it instead of passing through calls per vertex.
 template <PhotonIntegrator::Part kPart, class Stream>
 Rgb PhotonIntegrator::traceFrom(Vec3f origin, Vec3f dir, float time01, EyeVertex v, Stream& sampler,
                                 ThreadState& ts, Rgb* eye) const {

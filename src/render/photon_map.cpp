@@ -5,6 +5,19 @@
 
 namespace tdpm {
 
+PhotonMapSettings photonMapSettingsFor(const RenderOptions& opt, photon::MapKind kind, size_t wanted, uint64_t seed,
+                                       bool spreadInTime, float fixedTime01) {
+  PhotonMapSettings ms;
+  ms.trace.kind = kind;
+  ms.trace.storedWanted = wanted;
+  ms.trace.seed = seed;
+  ms.trace.maxBounces = opt.maxDepth;
+  ms.trace.spreadInTime = spreadInTime;
+  ms.trace.fixedTime01 = fixedTime01;
+  ms.trace.sampler = opt.sampler;
+  return ms;
+}
+
 double PhotonMap::bytesPerPhoton() const {
   if (store.empty()) return 0.0;
   double bytes = double(store.bytesAllocated()) + double(store3.bytesAllocated());

@@ -9,6 +9,7 @@
 #include "core/progress.h"
 #include "photon/kdtree.h"
 #include "photon/tracer.h"
+#include "render/render_options.h"
 
 namespace tdpm {
 
@@ -35,6 +36,19 @@ struct PhotonMapSettings {
   bool spaceTime = false;  // build the 4D tree (plus a 3D copy)
   float kappa = 1.0f;
 };
+
+// The settings every photon map of a render starts from, from its options:
+// the kind, the photons wanted, the seed, the bounces, the sampler, and when
+// the paths happen (spread over the shutter, or all at fixedTime01). The
+// callers add what is theirs: the communicator and the 4D tree (a
+// fixed-budget render, render/renderer.cpp), the pass's path range
+// (render/progressive.cpp). (Animation segments, render/animation.cpp, set
+// their own time window and seeds on a TraceSettings.)
+PhotonMapSettings photonMapSettingsFor(const RenderOptions& opt, photon::MapKind kind, size_t wanted, uint64_t seed,
+                                       bool spreadInTime, float fixedTime01);
+// Whether the options gather from a global map at all (final gather rays,
+// or --global-direct): if not, none is traced.
+inline bool wantsGlobalMap(const RenderOptions& opt) { return opt.visualizeGlobal || opt.gatherRays > 0; }
 
 std::unique_ptr<PhotonMap> buildPhotonMap(const Scene& scene, const PhotonMapSettings& settings,
                                           const Progress& progress);

@@ -23,6 +23,8 @@
 #include "dist/comm.h"
 #include "estimate/estimators.h"
 #include "photon/tracer.h"
+#include "render/camera_sample.h"
+#include "render/pixel_loop.h"
 #include "render/memory_budget.h"
 #include "render/photon_integrator.h"
 #include "render/photon_map.h"
@@ -131,7 +133,7 @@ void storeKernel(ProgressiveState& st, const char* map, const estimate::MapKerne
 
 float mainAlpha(const RenderOptions& opt) {
   if (opt.alpha > 0) return opt.alpha;
-  return opt.method == "time" ? kAlphaSpaceTime : kAlphaSpatial;
+  return renderMethodTraits(opt.method).defaultShrink == KernelShrink::SpaceTime ? kAlphaSpaceTime : kAlphaSpatial;
 }
 
 template <class Integrator>
@@ -156,62 +158,56 @@ void renderPassPixels(const Scene& scene, const PhotonIntegrator& integ, const R
   mean.assign(size_t(w) * size_t(h) * 3, 0.0f);
   float* out = mean.data();
   const Camera& cam = scene.camera;
-  const PixelFilter filter = pixelFilterFor(opt);
+  CameraSamplePlan plan{pixelFilterFor(opt), {}};
+  plan.times.fixed01 = fixedTime01;
+  plan.times.moving = scene.hasMotion;
   forEachTile<Scratch<PhotonIntegrator>>(w, h, stage, progress, [&](const Tile& t, Scratch<PhotonIntegrator>& s) {
-    for (int y = t.y0; y < t.y1; ++y)
-      for (int x = t.x0; x < t.x1; ++x) {
-        size_t idx = size_t(y) * size_t(w) + size_t(x);
-        const uint32_t m = counts.empty() ? uint32_t(spp) : counts[idx];
-        const uint32_t first = uint32_t(pass) * m;
-        PixelSampler ps(opt.seed, idx);
-        ps.startBatch(first, int(m));
-        // Sample i's camera ray, and its stream.
-        auto ray = [&](uint32_t i, Vec3f& o, Vec3f& d) {
-          CameraSample cs = ps.camera(i);
-          if (fixedTime01 >= 0) cs.time01 = fixedTime01;
-          else if (!scene.hasMotion) cs.time01 = 0.0f;
-          Vec2f p = filter.sample(cs.pixelOffset);  // filter importance sampling: weight 1
-          cam.generateRay({float(x) + p.x, float(y) + p.y}, cs.time01, o, d);
-          return cs.time01;
-        };
-        Rgb v;
-        if (m == uint32_t(spp)) {
-          double acc[3] = {0, 0, 0};
-          for (uint32_t i = first; i < first + m; ++i) {
-            Vec3f o, d;
-            float t01 = ray(i, o, d);
-            typename PixelSampler::Stream stream = ps.stream(i);
-            Rgb L = integ.radiance(o, d, t01, stream, s.state);
+    // The pixel in flight: its count m, its first index, and its sums (all
+    // samples full when m == spp; else eye and rest apart).
+    uint32_t m = 0, first = 0;
+    double eye[3], rest[3];
+    samplePixels<PixelSampler>(
+        t, w, cam, plan, opt.seed,
+        [&](size_t idx, uint32_t& f, uint32_t& c) {
+          m = counts.empty() ? uint32_t(spp) : counts[idx];
+          first = uint32_t(pass) * m;
+          f = first;
+          c = m;
+          for (int k = 0; k < 3; ++k) eye[k] = rest[k] = 0;
+          return true;
+        },
+        [&](size_t, uint32_t i, const CameraRay& ray, typename PixelSampler::Stream& stream) {
+          if (m == uint32_t(spp)) {
+            Rgb L = integ.radiance(ray.origin, ray.direction, ray.time01, stream, s.state);
             if (!isFinite(L)) L = saturateSample(L);
-            for (int c = 0; c < 3; ++c) acc[c] += double(L[c]);
+            for (int c = 0; c < 3; ++c) rest[c] += double(L[c]);
+            return;
           }
-          const double dm = double(m);
-          v = saturateSample(Rgb(float(acc[0] / dm), float(acc[1] / dm), float(acc[2] / dm)));
-        } else {
-          double eye[3] = {0, 0, 0}, rest[3] = {0, 0, 0};
-          for (uint32_t i = first; i < first + m; ++i) {
-            Vec3f o, d;
-            float t01 = ray(i, o, d);
-            typename PixelSampler::Stream stream = ps.stream(i);
-            Rgb e, L(0.0f);
-            if (i < first + uint32_t(spp)) {
-              L = saturateSample(integ.radianceSplit(o, d, t01, stream, s.state, e));
-              e = saturateSample(e);
-              L = saturateSample(L - e);
-            } else {
-              e = saturateSample(integ.eyePart(o, d, t01, stream, s.state));
-            }
-            for (int c = 0; c < 3; ++c) {
-              eye[c] += double(e[c]);
-              rest[c] += double(L[c]);
-            }
+          Rgb e, L(0.0f);
+          if (i < first + uint32_t(spp)) {
+            L = saturateSample(integ.radianceSplit(ray.origin, ray.direction, ray.time01, stream, s.state, e));
+            e = saturateSample(e);
+            L = saturateSample(L - e);
+          } else {
+            e = saturateSample(integ.eyePart(ray.origin, ray.direction, ray.time01, stream, s.state));
           }
-          Rgb r;
-          for (int c = 0; c < 3; ++c) r[c] = float(eye[c] / double(m) + rest[c] / double(spp));
-          v = saturateSample(r);
-        }
-        for (int c = 0; c < 3; ++c) out[3 * idx + size_t(c)] = v[c];
-      }
+          for (int c = 0; c < 3; ++c) {
+            eye[c] += double(e[c]);
+            rest[c] += double(L[c]);
+          }
+        },
+        [&](size_t idx) {
+          Rgb v;
+          if (m == uint32_t(spp)) {
+            const double dm = double(m);
+            v = saturateSample(Rgb(float(rest[0] / dm), float(rest[1] / dm), float(rest[2] / dm)));
+          } else {
+            Rgb r;
+            for (int c = 0; c < 3; ++c) r[c] = float(eye[c] / double(m) + rest[c] / double(spp));
+            v = saturateSample(r);
+          }
+          for (int c = 0; c < 3; ++c) out[3 * idx + size_t(c)] = v[c];
+        });
     integ.flush(s.state);
   });
 }
@@ -298,22 +294,16 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
                         const std::vector<uint32_t>& counts, const Progress& progress, RenderStats& st,
                         std::vector<float>& mean, const std::function<void()>& afterPilot) {
   Timer timer;
-  const bool accumulation = opt.method == "accumulation";
-  const bool spread = !accumulation && scene.hasMotion;
+  const RenderMethodTraits& method = renderMethodTraits(opt.method);
+  const bool accumulation = method.inBetweenFrames;  // a pass is one frame, at its own instant
+  const bool spread = method.spreadsPhotonsInTime && scene.hasMotion;
   const float passTime = accumulation && scene.hasMotion ? accumulationPassTime(pass, opt.seed) : -1.0f;
 
   double photonSeconds = 0;
   // ---- photons: pass 0 sizes the emission with the tracer's pilot; later
   //      passes trace the same number of paths at the next path indices ----
   auto trace = [&](photon::MapKind kind, size_t wanted, const char* key) -> std::unique_ptr<PhotonMap> {
-    PhotonMapSettings ms;
-    ms.trace.kind = kind;
-    ms.trace.seed = opt.seed;
-    ms.trace.maxBounces = opt.maxDepth;
-    ms.trace.spreadInTime = spread;
-    ms.trace.fixedTime01 = passTime >= 0 ? passTime : 0.0f;
-    ms.trace.sampler = opt.sampler;
-    ms.trace.storedWanted = wanted;
+    PhotonMapSettings ms = photonMapSettingsFor(opt, kind, wanted, opt.seed, spread, passTime >= 0 ? passTime : 0.0f);
     auto it = state.scalars.find(key);
     if (it != state.scalars.end()) {
       // A resumed value was checked (render/progressive_check.h): a whole
@@ -330,13 +320,13 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
     if (!m->warning.empty() && pass == 0) st.warnings.push_back(m->warning);
     return m;
   };
-  bool wantGlobal = opt.visualizeGlobal || opt.gatherRays > 0;
+  const bool wantGlobal = wantsGlobalMap(opt);
   std::unique_ptr<PhotonMap> caustic = trace(photon::MapKind::Caustic, opt.causticPhotons, "photons.caustic_paths_per_pass");
   std::unique_ptr<PhotonMap> global =
       trace(photon::MapKind::Global, wantGlobal ? opt.globalPhotons : 0, "photons.global_paths_per_pass");
 
   // ---- kernels: pass 1's from a k-NN pilot on pass 0's maps ----
-  const bool timeDependent = opt.method == "time" && scene.hasMotion;
+  const bool timeDependent = renderMethodTraits(opt.method).timeDependentEstimate && scene.hasMotion;
   if (!hasPilot(state)) {
     storeKernel(state, "caustic", pilotKernel(caustic.get(), scene, opt, timeDependent));
     storeKernel(state, "global", pilotKernel(global.get(), scene, opt, timeDependent));
@@ -426,7 +416,7 @@ std::string addPass(const Scene& scene, const RenderOptions& opt, ProgressiveSta
   st.photonSeconds += f.photonSeconds;
   if (f.causticStored + f.globalStored > 0) st.bytesPerPhoton = f.bytesPerPhoton;
 
-  const bool timeDependent = opt.method == "time" && scene.hasMotion;
+  const bool timeDependent = renderMethodTraits(opt.method).timeDependentEstimate && scene.hasMotion;
   PassKernels k = kernelsForPass(state, opt, scene, pass);
   state.passesDone = pass + 1;
   auto& sc = state.scalars;
@@ -440,8 +430,6 @@ std::string addPass(const Scene& scene, const RenderOptions& opt, ProgressiveSta
 }
 
 }  // namespace
-
-bool isProgressiveMethod(const std::string& m) { return m == "time" || m == "accumulation" || m == "standard"; }
 
 double kernelScale(int pass, double alpha, int dims) {
   double v = 1.0;
@@ -462,7 +450,7 @@ float accumulationPassTime(int pass, uint64_t seed) {
 }
 
 PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& opt, const Scene& scene, int pass) {
-  const bool time = opt.method == "time";
+  const bool time = renderMethodTraits(opt.method).timeDependentEstimate;  // has a space-time kernel
   const double alpha = mainAlpha(opt);
   const double binWidth = shutterOf(scene) / photon::kTimeBins;
   // time: the space-time kernel (d = 3) takes the main alpha, its spatial
@@ -522,16 +510,140 @@ Film filmFromState(const ProgressiveState& state, int width, int height) {
   return film;
 }
 
+namespace {
+
+// Where the pass loop stands, for the progress bar and pass lines.
+WorkPosition passPosition(const ProgressiveState& state, const RenderOptions& opt, double limit) {
+  return WorkPosition{"pass", size_t(state.passesDone), size_t(std::max(0, opt.passes)), limit,
+                      uint64_t(scalarOr(state, "photons.emitted", 0))};
+}
+
+// A new state gets its zero layers and its settings; a resumed one is
+// checked against the image size. The sums live on rank 0 only.
+void prepareState(ProgressiveState& state, const RenderOptions& opt, int w, int h, dist::Comm& comm) {
+  const size_t n = size_t(w) * size_t(h);
+  if (state.empty()) {
+    state.layers.clear();
+    state.scalars.clear();
+  }
+  for (const char* name : kLayers) {
+    if (!comm.root()) break;  // the sums live on rank 0 only
+    std::vector<float>& l = state.layers[name];
+    if (state.empty()) l.assign(n, 0.0f);
+    else if (l.size() != n)
+      throw Error(std::string("progressive state: layer '") + name + "' holds " + std::to_string(l.size()) +
+                  " pixels, the image has " + std::to_string(n) + " (" + std::to_string(w) + "x" + std::to_string(h) + ")");
+  }
+  if (state.settings.empty()) {
+    char a[32];
+    std::snprintf(a, sizeof a, "%.9g", double(mainAlpha(opt)));
+    state.settings = {{"method", renderMethodName(opt.method)},
+                      {"seed", std::to_string(opt.seed)},
+                      {"sampler", samplerName(opt.sampler)},
+                      {"spp", std::to_string(opt.spp)},
+                      {"photons", std::to_string(opt.causticPhotons)},
+                      {"global_photons", std::to_string(opt.globalPhotons)},
+                      {"alpha", a},
+                      {"max_depth", std::to_string(opt.maxDepth)},
+                      {"gather", std::to_string(opt.gatherRays)},
+                      {"k", std::to_string(opt.estimate.k)},
+                      {"resolution", std::to_string(w) + "x" + std::to_string(h)}};
+  }
+}
+
+// One process: passes until --passes are done, the time limit is reached
+// or a signal asks to stop (after the pass in flight).
+void runLocalPasses(const Scene& scene, const RenderOptions& opt, ProgressiveState& state, const Progress& progress,
+                    RenderStats& st, const std::vector<uint32_t>& counts, double limit, const Timer& timer) {
+  for (;;) {
+    if (opt.passes > 0 && state.passesDone >= opt.passes) break;
+    if (state.passesDone >= maxProgressivePasses()) break;  // what a resume accepts (progressive_check.h)
+    runProgressivePass(scene, opt, state, progress, st, counts);
+    progress.at(passPosition(state, opt, limit));
+    if (limit > 0 && timer.seconds() >= limit) break;
+    if (signals::stopRequested()) break;
+  }
+}
+
+// Rounds of N passes (docs/distributed.md): rank r runs pass first + r
+// alone, rank 0 adds the round's passes in pass order with addPass (the
+// same float additions as one process), then the job decides together
+// whether to stop. Pass 0 of a new render computes the pilot values on
+// rank 0, which sends them before rendering its pixels; the others wait
+// for them, then run their passes. Returns true when a round was dropped
+// (a signal: the rounds done before it stand).
+bool runDistributedRounds(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
+                          const Progress& progress, RenderStats& st, const std::vector<uint32_t>& counts, double limit,
+                          const Timer& timer, dist::Comm& comm) {
+  const int N = comm.size(), rank = comm.rank();
+  for (bool stop = false; !stop;) {
+    const int first = state.passesDone;
+    const int inRound =
+        std::min(opt.passes > 0 ? std::min(N, opt.passes - first) : N, maxProgressivePasses() - first);
+    if (inRound <= 0) break;
+    const bool has = rank < inRound;
+    const bool needPilot = !hasPilot(state);
+    bool cancelled = false, pilotSent = false;
+    if (needPilot && !comm.root()) cancelled = !sharePilot(comm, state);
+    std::vector<float> mean;
+    std::vector<double> figures;
+    if (has && !cancelled) {
+      RenderStats own;  // warnings (rank 0's pass 0 only)
+      try {
+        PassFigures f = computePass(scene, opt, state, first + rank, counts, cancellable(comm.root() ? progress : Progress{}),
+                                    own, mean, [&] {
+                                      if (needPilot) sharePilot(comm, state);
+                                      pilotSent = true;
+                                    });
+        if (comm.root()) st.warnings.insert(st.warnings.end(), own.warnings.begin(), own.warnings.end());
+        figures = f.pack();
+      } catch (const PassCancelled&) {
+        cancelled = true;
+      }
+    }
+    if (needPilot && comm.root() && !pilotSent) sharePilot(comm, state, false);  // the others wait for it
+    // A rank that abandoned its pass drops the whole round: the job
+    // stops with the rounds done before it (an integer sum, so every
+    // rank decides alike).
+    uint64_t dropped = cancelled ? 1 : 0;
+    comm.allreduceSum(&dropped, 1);
+    if (dropped > 0) return true;
+    std::vector<PassFigures> roundFigures;
+    dist::combineRoundOnRoot(comm, figures, has,
+                             [&](const double* v, size_t) { roundFigures.push_back(PassFigures::unpack(v)); });
+    size_t next = 0;
+    std::string overflow;
+    dist::combineRoundOnRoot(comm, mean, has, [&](const float* v, size_t) {
+      std::string e = addPass(scene, opt, state, v, counts, roundFigures[next++], st);
+      if (overflow.empty()) overflow = e;
+    });
+    dist::raiseIfAnyFailed(comm, overflow);  // rank 0 alone adds: every rank learns it
+    state.passesDone = first + inRound;
+    if (comm.root()) progress.at(passPosition(state, opt, limit));
+    // Stop when rank 0 says so (time limit) or any rank was asked to stop
+    // by a signal (mpirun forwards SIGTERM to every rank).
+    uint64_t want = uint64_t((comm.root() && limit > 0 && timer.seconds() >= limit) || signals::stopRequested());
+    comm.allreduceSum(&want, 1);
+    stop = want > 0;
+  }
+  return false;
+}
+
+}  // namespace
+
+// One level: the checks, the state, the pass loop (local or in rounds over
+// the ranks), the film from the sums.
 Film renderProgressive(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
                        const Progress& progress, RenderStats& st, dist::Comm& comm) {
-  if (!isProgressiveMethod(opt.method))
-    throw Error("--progressive works with the methods time, accumulation and standard, not '" + opt.method + "'");
+  if (!renderMethodTraits(opt.method).progressive)
+    throw Error("--progressive works with the methods time, accumulation and standard, not '" +
+                std::string(renderMethodName(opt.method)) + "'");
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
   // One pass's memory, as a fixed-budget render of the same photon counts
   // (a fixed-budget accumulation would split them over its frames: a pass
   // holds them all, as standard does).
   RenderOptions budget = opt;
-  if (budget.method == "accumulation") budget.method = "standard";
+  if (renderMethodTraits(budget.method).inBetweenFrames) budget.method = RenderMethod::Standard;
   std::string budgetError;
   try {
     checkMemoryBudget(scene, budget, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
@@ -551,114 +663,17 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
   st.warnings = sceneWarnings(scene);
   const int w = scene.camera.width(), h = scene.camera.height();
   const size_t n = size_t(w) * size_t(h);
-  if (state.empty()) {
-    state.layers.clear();
-    state.scalars.clear();
-  }
-  for (const char* name : kLayers) {
-    if (!comm.root()) break;  // the sums live on rank 0 only
-    std::vector<float>& l = state.layers[name];
-    if (state.empty()) l.assign(n, 0.0f);
-    else if (l.size() != n)
-      throw Error(std::string("progressive state: layer '") + name + "' holds " + std::to_string(l.size()) +
-                  " pixels, the image has " + std::to_string(n) + " (" + std::to_string(w) + "x" + std::to_string(h) + ")");
-  }
-  if (state.settings.empty()) {
-    char a[32];
-    std::snprintf(a, sizeof a, "%.9g", double(mainAlpha(opt)));
-    state.settings = {{"method", opt.method},
-                      {"seed", std::to_string(opt.seed)},
-                      {"sampler", samplerName(opt.sampler)},
-                      {"spp", std::to_string(opt.spp)},
-                      {"photons", std::to_string(opt.causticPhotons)},
-                      {"global_photons", std::to_string(opt.globalPhotons)},
-                      {"alpha", a},
-                      {"max_depth", std::to_string(opt.maxDepth)},
-                      {"gather", std::to_string(opt.gatherRays)},
-                      {"k", std::to_string(opt.estimate.k)},
-                      {"resolution", std::to_string(w) + "x" + std::to_string(h)}};
-  }
+  prepareState(state, opt, w, h, comm);
   double limit = opt.timeLimitSeconds;
   if (opt.passes <= 0 && !(limit > 0)) limit = kDefaultProgressiveSeconds;
-  auto position = [&] {
-    return WorkPosition{"pass", size_t(state.passesDone), size_t(std::max(0, opt.passes)), limit,
-                        uint64_t(scalarOr(state, "photons.emitted", 0))};
-  };
-  progress.at(position());
+  progress.at(passPosition(state, opt, limit));
   // Samples per pixel and pass: the same map in every run and on every rank
   // (a function of scene, options and seed; render/sample_allocation.h).
   const std::vector<uint32_t> counts = passSampleCounts(scene, opt, progress, comm);
   if (!comm.distributed()) {
-    for (;;) {
-      if (opt.passes > 0 && state.passesDone >= opt.passes) break;
-      if (state.passesDone >= maxProgressivePasses()) break;  // what a resume accepts (progressive_check.h)
-      runProgressivePass(scene, opt, state, progress, st, counts);
-      progress.at(position());
-      if (limit > 0 && timer.seconds() >= limit) break;
-      if (signals::stopRequested()) break;
-    }
+    runLocalPasses(scene, opt, state, progress, st, counts, limit, timer);
   } else {
-    // Rounds of N passes (docs/distributed.md): rank r runs pass first + r
-    // alone, rank 0 adds the round's passes in pass order with addPass (the
-    // same float additions as one process), then the job decides together
-    // whether to stop. Pass 0 of a new render computes the pilot values on
-    // rank 0, which sends them before rendering its pixels; the others wait
-    // for them, then run their passes.
-    const int N = comm.size(), rank = comm.rank();
-    bool roundDropped = false;
-    for (bool stop = false; !stop;) {
-      const int first = state.passesDone;
-      const int inRound =
-          std::min(opt.passes > 0 ? std::min(N, opt.passes - first) : N, maxProgressivePasses() - first);
-      if (inRound <= 0) break;
-      const bool has = rank < inRound;
-      const bool needPilot = !hasPilot(state);
-      bool cancelled = false, pilotSent = false;
-      if (needPilot && !comm.root()) cancelled = !sharePilot(comm, state);
-      std::vector<float> mean;
-      std::vector<double> figures;
-      if (has && !cancelled) {
-        RenderStats own;  // warnings (rank 0's pass 0 only)
-        try {
-          PassFigures f = computePass(scene, opt, state, first + rank, counts, cancellable(comm.root() ? progress : Progress{}),
-                                      own, mean, [&] {
-                                        if (needPilot) sharePilot(comm, state);
-                                        pilotSent = true;
-                                      });
-          if (comm.root()) st.warnings.insert(st.warnings.end(), own.warnings.begin(), own.warnings.end());
-          figures = f.pack();
-        } catch (const PassCancelled&) {
-          cancelled = true;
-        }
-      }
-      if (needPilot && comm.root() && !pilotSent) sharePilot(comm, state, false);  // the others wait for it
-      // A rank that abandoned its pass drops the whole round: the job
-      // stops with the rounds done before it (an integer sum, so every
-      // rank decides alike).
-      uint64_t dropped = cancelled ? 1 : 0;
-      comm.allreduceSum(&dropped, 1);
-      if (dropped > 0) {
-        roundDropped = true;
-        break;
-      }
-      std::vector<PassFigures> roundFigures;
-      dist::combineRoundOnRoot(comm, figures, has,
-                               [&](const double* v, size_t) { roundFigures.push_back(PassFigures::unpack(v)); });
-      size_t next = 0;
-      std::string overflow;
-      dist::combineRoundOnRoot(comm, mean, has, [&](const float* v, size_t) {
-        std::string e = addPass(scene, opt, state, v, counts, roundFigures[next++], st);
-        if (overflow.empty()) overflow = e;
-      });
-      dist::raiseIfAnyFailed(comm, overflow);  // rank 0 alone adds: every rank learns it
-      state.passesDone = first + inRound;
-      if (comm.root()) progress.at(position());
-      // Stop when rank 0 says so (time limit) or any rank was asked to stop
-      // by a signal (mpirun forwards SIGTERM to every rank).
-      uint64_t want = uint64_t((comm.root() && limit > 0 && timer.seconds() >= limit) || signals::stopRequested());
-      comm.allreduceSum(&want, 1);
-      stop = want > 0;
-    }
+    const bool roundDropped = runDistributedRounds(scene, opt, state, progress, st, counts, limit, timer, comm);
     if (roundDropped && state.passesDone == 0)  // every rank knows: an agreed error, rank 0 says it
       throw dist::AgreedError("stopped by a signal before the first round of passes ended: nothing to write");
     if (!comm.root()) {

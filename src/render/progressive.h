@@ -43,8 +43,6 @@ constexpr double kDefaultProgressiveSeconds = 30.0;
 constexpr float kAlphaSpaceTime = 4.0f / 7.0f;  // disc x window, d = 3
 constexpr float kAlphaSpatial = 2.0f / 3.0f;    // disc, d = 2
 
-bool isProgressiveMethod(const std::string& method);
-
 // Both kernels of each map for one pass.
 struct PassKernels {
   estimate::MapKernel caustic, global;

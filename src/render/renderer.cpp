@@ -16,6 +16,8 @@
 #include "core/rng.h"
 #include "core/timer.h"
 #include "photon/tracer.h"
+#include "render/camera_sample.h"
+#include "render/pixel_loop.h"
 #include "render/path_tracer.h"
 #include "render/photon_integrator.h"
 #include "render/memory_budget.h"
@@ -28,8 +30,6 @@
 namespace tdpm {
 
 namespace {
-
-const char* const kMethods[] = {"pathtrace", "static", "accumulation", "standard", "time", nullptr};
 
 // Streams a pixel's samples into a mean and the variance of that mean
 // (Welford's update: stable in one pass). The sums of squares are doubles:
@@ -83,9 +83,9 @@ struct SamplingPlan {
   float contrast = 0.05f;
   uint64_t seed = 1;
   SamplerKind sampler = SamplerKind::Sobol;
-  PixelFilter filter;           // where in (and around) the pixel a sample lands
-  bool sampleTime = true;       // false: a scene without motion draws no times
-  float fixedTime01 = -1.0f;    // >= 0: every sample at this time (accumulation frames)
+  // The filter and the time remap of every camera sample (render/camera_sample.h):
+  // a still scene, an accumulation frame's instant, an animation frame's part.
+  CameraSamplePlan camera;
   // Distributed render: this rank samples only its own tiles, and the
   // half-buffer errors of every pixel are shared between passes.
   dist::Comm* comm = &dist::local();
@@ -95,7 +95,6 @@ struct SamplingPlan {
   // samples (and its running mean) stay on one rank. Null: the fixed
   // interleave (TileShare).
   TileOwners* owners = nullptr;
-  float time01Lo = 0.0f, time01Hi = 1.0f;  // animation frames: sample times in this part of the shutter
 };
 
 // The plan every render and every animation frame starts from.
@@ -106,7 +105,7 @@ SamplingPlan samplingPlanFor(const RenderOptions& opt) {
   plan.contrast = opt.contrast;
   plan.seed = opt.seed;
   plan.sampler = opt.sampler;
-  plan.filter = pixelFilterFor(opt);
+  plan.camera.filter = pixelFilterFor(opt);
   return plan;
 }
 
@@ -123,30 +122,22 @@ void samplePass(const Scene& scene, const Integrator& integrator, const Sampling
                 const Progress& progress, int width, int height) {
   const Camera& cam = scene.camera;
   auto tileFn = [&](const Tile& t, PixelScratch<Integrator>& s) {
-    for (int y = t.y0; y < t.y1; ++y)
-      for (int x = t.x0; x < t.x1; ++x) {
-        size_t idx = size_t(y) * size_t(width) + size_t(x);
-        if (!active[idx]) continue;
-        PixelSampler ps(plan.seed, idx);
-        ps.startBatch(first, count);
-        PixelAccumulator& acc = accs[idx];
-        for (uint32_t i = first; i < first + uint32_t(count); ++i) {
-          CameraSample cs = ps.camera(i);
-          if (plan.fixedTime01 >= 0) cs.time01 = plan.fixedTime01;
-          else if (!plan.sampleTime) cs.time01 = 0.0f;
-          else cs.time01 = plan.time01Lo + cs.time01 * (plan.time01Hi - plan.time01Lo);  // whole shutter: unchanged
-          Vec3f o, d;
-          Vec2f p = plan.filter.sample(cs.pixelOffset);  // filter importance sampling: weight 1
-          cam.generateRay({float(x) + p.x, float(y) + p.y}, cs.time01, o, d);
-          typename PixelSampler::Stream stream = ps.stream(i);
-          Rgb L = integrator.radiance(o, d, cs.time01, stream, s.state);
+    samplePixels<PixelSampler>(
+        t, width, cam, plan.camera, plan.seed,
+        [&](size_t idx, uint32_t& f, uint32_t& c) {
+          f = first;
+          c = uint32_t(count);
+          return active[idx] != 0;
+        },
+        [&](size_t idx, uint32_t i, const CameraRay& ray, typename PixelSampler::Stream& stream) {
+          Rgb L = integrator.radiance(ray.origin, ray.direction, ray.time01, stream, s.state);
           // A NaN sample is a bug upstream; never let it reach the film. An
           // infinite one is a finite scene overflowing float (a tiny
           // emitter of huge power): it saturates, as a sensor would.
           if (!isFinite(L)) L = saturateSample(L);
-          acc.add(L, i);
-        }
-      }
+          accs[idx].add(L, i);
+        },
+        [](size_t) {});
     integrator.flush(s.state);
   };
   dist::Comm& comm = *plan.comm;
@@ -255,21 +246,15 @@ Maps tracePhotonMaps(const Scene& scene, const RenderOptions& opt, size_t causti
                      bool spreadInTime, float fixedTime01, uint64_t seed, const Progress& progress, RenderStats& st,
                      dist::Comm& comm) {
   Maps maps;
-  PhotonMapSettings ms;
-  ms.trace.comm = &comm;
-  ms.spaceTime = opt.spaceTime4D && spreadInTime;
-  ms.kappa = opt.kappa;
-  ms.trace.seed = seed;
-  ms.trace.maxBounces = opt.maxDepth;
-  ms.trace.spreadInTime = spreadInTime;
-  ms.trace.fixedTime01 = fixedTime01;
-  ms.trace.sampler = opt.sampler;
-  ms.trace.kind = photon::MapKind::Caustic;
-  ms.trace.storedWanted = causticWanted;
-  maps.caustic = buildPhotonMap(scene, ms, progress);
-  ms.trace.kind = photon::MapKind::Global;
-  ms.trace.storedWanted = opt.visualizeGlobal || opt.gatherRays > 0 ? globalWanted : 0;
-  maps.global = buildPhotonMap(scene, ms, progress);
+  auto settings = [&](photon::MapKind kind, size_t wanted) {
+    PhotonMapSettings ms = photonMapSettingsFor(opt, kind, wanted, seed, spreadInTime, fixedTime01);
+    ms.trace.comm = &comm;
+    ms.spaceTime = opt.spaceTime4D && spreadInTime;
+    ms.kappa = opt.kappa;
+    return ms;
+  };
+  maps.caustic = buildPhotonMap(scene, settings(photon::MapKind::Caustic, causticWanted), progress);
+  maps.global = buildPhotonMap(scene, settings(photon::MapKind::Global, wantsGlobalMap(opt) ? globalWanted : 0), progress);
   for (const PhotonMap* m : {maps.caustic.get(), maps.global.get()}) {
     st.photonSeconds += m->traceSeconds + m->buildSeconds;
     if (!m->warning.empty()) st.warnings.push_back(m->warning);
@@ -421,24 +406,97 @@ std::vector<std::string> sceneWarnings(const Scene& scene) {
   return w;
 }
 
-const char* const* renderMethods() { return kMethods; }
-
 PixelFilter pixelFilterFor(const RenderOptions& opt) {
   return PixelFilter(opt.filter, opt.filterRadius > 0 ? opt.filterRadius : defaultFilterRadius(opt.filter));
 }
 
-bool isRenderMethod(const std::string& name) {
-  for (const char* const* m = kMethods; *m; ++m)
-    if (name == *m) return true;
-  return false;
+namespace {
+
+// pathtrace: the caustic guide, then the adaptive passes.
+void renderPathTraced(const Scene& scene, const RenderOptions& opt, const SamplingPlan& plan, const Progress& progress,
+                      RenderStats& st, Film& film) {
+  CausticGuide guide = buildCausticGuide(scene, opt, progress, st);
+  PathTracer pt(scene, opt.maxDepth, &guide);
+  renderPixels(scene, pt, plan, "render", progress, film);
+  st.guideCellsFilled = guide.cacheFilled();
 }
 
+// accumulation: N in-between frames at equally spaced times, each with its
+// own maps holding 1/N of the budget, rendered at its own time and averaged.
+void renderAccumulation(const Scene& scene, const RenderOptions& opt, const SamplingPlan& plan,
+                        const Progress& progress, RenderStats& st, dist::Comm& comm, Film& film) {
+  int frames = scene.hasMotion ? std::max(1, opt.frames) : 1;
+  size_t causticPer = (opt.causticPhotons + size_t(frames) - 1) / size_t(frames);
+  size_t globalPer = (opt.globalPhotons + size_t(frames) - 1) / size_t(frames);
+  SamplingPlan framePlan = plan;
+  framePlan.batch = std::max(1, opt.spp / frames);
+  framePlan.maxSpp = std::max(framePlan.batch, plan.maxSpp / frames);
+  Film sum(film.width, film.height);
+  for (int f = 0; f < frames; ++f) {
+    float t01 = (float(f) + 0.5f) / float(frames);
+    Maps maps = tracePhotonMaps(scene, opt, causticPer, globalPer, false, t01, hashCombine(opt.seed, uint64_t(f)),
+                                progress, st, comm);
+    PhotonIntegrator integ(scene, maps.caustic.get(), maps.global.get(), integratorSettings(scene, opt, false));
+    framePlan.camera.times.fixed01 = t01;
+    framePlan.seed = hashCombine(opt.seed, 0xacc0ull + uint64_t(f));
+    Film one(film.width, film.height);
+    std::string stage = "frame " + std::to_string(f + 1) + "/" + std::to_string(frames);
+    renderPixels(scene, integ, framePlan, stage.c_str(), progress, one);
+    EstimateCounts c = integ.counts();
+    st.standardEstimates += c.standard;
+    for (size_t i = 0; i < sum.color.size(); ++i) {
+      sum.color[i] += one.color[i];
+      sum.sampleCount[i] += one.sampleCount[i];
+      sum.varianceOfMean[i] += one.varianceOfMean[i];
+    }
+  }
+  float inv = 1.0f / float(frames);
+  // Frames near FLT_MAX can sum to infinity: saturate, as each frame did.
+  for (size_t i = 0; i < film.color.size(); ++i) {
+    film.color[i] = saturateSample(sum.color[i] * inv);
+    film.sampleCount[i] = sum.sampleCount[i];
+    film.varianceOfMean[i] = saturateSample(sum.varianceOfMean[i] * (inv * inv));  // var of an average of independent frames
+  }
+}
+
+// static, standard and time: one pair of maps (static: photons at shutter
+// open; standard and time: spread in time), then the adaptive passes.
+void renderPhotonMapped(const Scene& scene, const RenderOptions& opt, const SamplingPlan& plan,
+                        const Progress& progress, RenderStats& st, dist::Comm& comm, Film& film) {
+  const RenderMethodTraits& method = renderMethodTraits(opt.method);
+  bool spread = method.spreadsPhotonsInTime && scene.hasMotion;
+  bool timeDependent = method.timeDependentEstimate && scene.hasMotion;
+  Maps maps = tracePhotonMaps(scene, opt, opt.causticPhotons, opt.globalPhotons, spread, 0.0f, opt.seed, progress, st, comm);
+  PhotonIntegrator integ(scene, maps.caustic.get(), maps.global.get(), integratorSettings(scene, opt, timeDependent));
+  renderPixels(scene, integ, plan, "render", progress, film);
+  EstimateCounts c = integ.counts();
+  st.standardEstimates = c.standard;
+  st.timeEstimates = c.timeDependent;
+}
+
+// Distributed: rank 0 gathers the film from the tiles' owners; estimate
+// counts are summed (integers) on every rank.
+void gatherFilm(dist::Comm& comm, TileOwners& owners, RenderStats& st, Film& film) {
+  if (!comm.distributed()) return;
+  if (owners.empty()) owners = staticTileOwners(film.width, film.height, comm.size());
+  sharePixels(comm, film.width, film.height, film.color, false, owners);
+  sharePixels(comm, film.width, film.height, film.sampleCount, false, owners);
+  sharePixels(comm, film.width, film.height, film.varianceOfMean, false, owners);
+  uint64_t counts[2] = {st.standardEstimates, st.timeEstimates};
+  comm.allreduceSum(counts, 2);
+  st.standardEstimates = counts[0];
+  st.timeEstimates = counts[1];
+}
+
+}  // namespace
+
+// One level: the memory check, the method's render, the gather.
 Film render(const Scene& scene, const RenderOptions& opt, const Progress& progress, RenderStats& st, dist::Comm& comm) {
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
-  if (!isRenderMethod(opt.method)) throw Error("unknown method '" + opt.method + "'");
-  if (opt.progressive) {  // render/progressive.h, from pass 0
+  const RenderMethodTraits& method = renderMethodTraits(opt.method);
+  if (opt.progressive) {  // render/progressive.h, from pass 0, on the same ranks
     ProgressiveState state;
-    return renderProgressive(scene, opt, state, progress, st);
+    return renderProgressive(scene, opt, state, progress, st, comm);
   }
   // Before any work: an image or photon budget that cannot fit is an error,
   // not an OOM kill (render/memory_budget.h). Every rank holds the whole
@@ -456,73 +514,15 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
   Film film(scene.camera.width(), scene.camera.height());
   SamplingPlan plan = samplingPlanFor(opt);
   // A scene with no motion at all draws no time samples.
-  plan.sampleTime = scene.hasMotion;
+  plan.camera.times.moving = scene.hasMotion;
   plan.comm = &comm;
   TileOwners owners;  // filled by the first pass (a distributed render's tile queue)
   plan.owners = &owners;
 
-  if (opt.method == "pathtrace") {
-    CausticGuide guide = buildCausticGuide(scene, opt, progress, st);
-    PathTracer pt(scene, opt.maxDepth, &guide);
-    renderPixels(scene, pt, plan, "render", progress, film);
-    st.guideCellsFilled = guide.cacheFilled();
-  } else if (opt.method == "accumulation") {
-    // N in-between frames at equally spaced times, each with its own maps
-    // holding 1/N of the budget, rendered at its own time and averaged.
-    int frames = scene.hasMotion ? std::max(1, opt.frames) : 1;
-    size_t causticPer = (opt.causticPhotons + size_t(frames) - 1) / size_t(frames);
-    size_t globalPer = (opt.globalPhotons + size_t(frames) - 1) / size_t(frames);
-    SamplingPlan framePlan = plan;
-    framePlan.batch = std::max(1, opt.spp / frames);
-    framePlan.maxSpp = std::max(framePlan.batch, plan.maxSpp / frames);
-    Film sum(film.width, film.height);
-    for (int f = 0; f < frames; ++f) {
-      float t01 = (float(f) + 0.5f) / float(frames);
-      Maps maps = tracePhotonMaps(scene, opt, causticPer, globalPer, false, t01, hashCombine(opt.seed, uint64_t(f)),
-                                  progress, st, comm);
-      PhotonIntegrator integ(scene, maps.caustic.get(), maps.global.get(), integratorSettings(scene, opt, false));
-      framePlan.fixedTime01 = t01;
-      framePlan.seed = hashCombine(opt.seed, 0xacc0ull + uint64_t(f));
-      Film one(film.width, film.height);
-      std::string stage = "frame " + std::to_string(f + 1) + "/" + std::to_string(frames);
-      renderPixels(scene, integ, framePlan, stage.c_str(), progress, one);
-      EstimateCounts c = integ.counts();
-      st.standardEstimates += c.standard;
-      for (size_t i = 0; i < sum.color.size(); ++i) {
-        sum.color[i] += one.color[i];
-        sum.sampleCount[i] += one.sampleCount[i];
-        sum.varianceOfMean[i] += one.varianceOfMean[i];
-      }
-    }
-    float inv = 1.0f / float(frames);
-    // Frames near FLT_MAX can sum to infinity: saturate, as each frame did.
-    for (size_t i = 0; i < film.color.size(); ++i) {
-      film.color[i] = saturateSample(sum.color[i] * inv);
-      film.sampleCount[i] = sum.sampleCount[i];
-      film.varianceOfMean[i] = saturateSample(sum.varianceOfMean[i] * (inv * inv));  // var of an average of independent frames
-    }
-  } else {
-    // static: photons at shutter open; standard and time: spread in time.
-    bool spread = opt.method != "static" && scene.hasMotion;
-    bool timeDependent = opt.method == "time" && scene.hasMotion;
-    Maps maps = tracePhotonMaps(scene, opt, opt.causticPhotons, opt.globalPhotons, spread, 0.0f, opt.seed, progress, st, comm);
-    PhotonIntegrator integ(scene, maps.caustic.get(), maps.global.get(), integratorSettings(scene, opt, timeDependent));
-    renderPixels(scene, integ, plan, "render", progress, film);
-    EstimateCounts c = integ.counts();
-    st.standardEstimates = c.standard;
-    st.timeEstimates = c.timeDependent;
-  }
-  if (comm.distributed()) {
-    // Rank 0 gathers the film; estimate counts are summed (integers).
-    if (owners.empty()) owners = staticTileOwners(film.width, film.height, comm.size());
-    sharePixels(comm, film.width, film.height, film.color, false, owners);
-    sharePixels(comm, film.width, film.height, film.sampleCount, false, owners);
-    sharePixels(comm, film.width, film.height, film.varianceOfMean, false, owners);
-    uint64_t counts[2] = {st.standardEstimates, st.timeEstimates};
-    comm.allreduceSum(counts, 2);
-    st.standardEstimates = counts[0];
-    st.timeEstimates = counts[1];
-  }
+  if (!method.photonMaps) renderPathTraced(scene, opt, plan, progress, st, film);
+  else if (method.inBetweenFrames) renderAccumulation(scene, opt, plan, progress, st, comm, film);
+  else renderPhotonMapped(scene, opt, plan, progress, st, comm, film);
+  gatherFilm(comm, owners, st, film);
   finishStats(film, st);
   st.seconds = timer.seconds();
   st.peakResidentBytes = peakResidentBytes();
@@ -536,15 +536,12 @@ Film renderFrame(const Scene& scene, const RenderOptions& opt, const FrameInput&
   st = RenderStats{};
   Film film(scene.camera.width(), scene.camera.height());
   SamplingPlan plan = samplingPlanFor(opt);
-  plan.time01Lo = scene.shutter.normalized(frame.shutter.open);
-  plan.time01Hi = scene.shutter.normalized(frame.shutter.close);
-  if (opt.method == "pathtrace") {
-    CausticGuide guide = buildCausticGuide(scene, opt, progress, st);
-    PathTracer pt(scene, opt.maxDepth, &guide);
-    renderPixels(scene, pt, plan, "render", progress, film);
-    st.guideCellsFilled = guide.cacheFilled();
+  plan.camera.times.lo01 = scene.shutter.normalized(frame.shutter.open);
+  plan.camera.times.hi01 = scene.shutter.normalized(frame.shutter.close);
+  if (!renderMethodTraits(opt.method).photonMaps) {
+    renderPathTraced(scene, opt, plan, progress, st, film);
   } else {
-    PhotonIntegratorSettings s = integratorSettings(scene, opt, opt.method == "time" && scene.hasMotion);
+    PhotonIntegratorSettings s = integratorSettings(scene, opt, renderMethodTraits(opt.method).timeDependentEstimate && scene.hasMotion);
     if (!std::isfinite(opt.estimate.maxTimeDistance))
       s.estimate.maxTimeDistance = opt.maxDtFraction * frame.shutter.length();
     PhotonIntegrator integ(scene, frame.caustic, frame.global, s);

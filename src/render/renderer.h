@@ -12,6 +12,7 @@
 #include "estimate/estimators.h"
 #include "motion/shutter.h"
 #include "render/film.h"
+#include "render/render_options.h"
 #include "sampling/filter.h"
 #include "sampling/sampler.h"
 #include "scene/scene.h"
@@ -34,103 +35,10 @@ inline constexpr int kAdaptiveMinSamples = 64;
 // activity flag (1) and its half-buffer error (4).
 inline constexpr uint64_t kSamplerBytesPerPixel = 61;
 
-struct RenderOptions {
-  std::string method = "time";  // pathtrace | static | accumulation | standard | time
-  // Adaptive sampling: every pixel takes `spp` samples, then further
-  // batches of `spp` while the relative error of its mean luminance (judged
-  // from two interleaved half-buffers over its 3x3 neighbourhood, at least
-  // 64 samples, see renderer.cpp) exceeds `contrast` x sqrt(n / 64) after
-  // n samples, up to maxSpp.
-  // maxSpp <= spp: exactly spp samples everywhere.
-  int spp = 16;
-  int maxSpp = 0;
-  float contrast = 0.05f;
-  uint64_t seed = 1;
-  SamplerKind sampler = SamplerKind::Sobol;  // sampling/sampler.h
-  FilterKind filter = FilterKind::Box;       // sampling/filter.h
-  float filterRadius = 0.0f;                 // pixels; 0: the kind's default
-  int maxDepth = 16;
-  // Path tracing: the share (at most) of the first two diffuse vertices'
-  // continuation samples aimed where caustic photons came from
-  // (render/caustic_guide.h; 0 samples the BSDF alone), and the photons
-  // that guide is built from
-  // (0: one per 100 camera samples, 20k to 200k).
-  float causticGuiding = 0.5f;
-  size_t guidePhotons = 0;
-
-  // ---- photon methods ----
-  size_t causticPhotons = 200000;  // stored photons wanted
-  size_t globalPhotons = 50000;
-  int frames = 8;                  // accumulation: in-between frames
-  bool spaceTime4D = false;        // --search 4d
-  float kappa = 1.0f;              // 4D metric weight
-  estimate::Options estimate;      // k, ks, fraction, max radius / dt, kernels
-  float maxRadiusFraction = 0.02f; // max radius when estimate.maxRadius is not set: of the scene's diagonal
-  // Largest time distance kept by the two-pass search when
-  // estimate.maxTimeDistance is not set, as a fraction of the shutter: the
-  // nearest-in-time estimate decays only as k f / (2 dt) away from a moving
-  // caustic, and those tails smear a sharp spot (Delta t_max of method.md).
-  float maxDtFraction = 0.1f;
-  // Two-pass time estimate seen from the camera: its space-time kernel is
-  // at least this many times one eye sample's share of its pixel (pixel
-  // area at the path's length x shutter / spp); 0: pure k-NN. A smaller
-  // kernel resolves what the eye samples cannot, and the image turns
-  // heavy-tailed (docs/photon-map.md, "The estimate's variance").
-  float kernelFootprint = 1.0f;
-  int gatherRays = 1;
-  bool visualizeGlobal = false;
-  // How the user set the two photon counts, for the memory-budget error:
-  // the flag, or the scene key and file (cli/render_command.cpp sets these).
-  std::string causticPhotonsSource = "--photons";
-  std::string globalPhotonsSource = "--global-photons";
-  // How the image size was set, for the memory-budget error.
-  std::string resolutionSource = "the camera resolution";
-
-  // ---- progressive passes (render/progressive.h): time, accumulation, standard ----
-  bool progressive = false;
-  int passes = 0;                 // stop once this many passes are done in all (0: the time limit decides)
-  double timeLimitSeconds = 0;    // > 0: stop after the pass that reaches it (this run's seconds)
-  float alpha = 0;                // > 0: overrides the variant's alpha (docs/photon-map.md)
-  // Eye samples where the eye paths are noisy (render/sample_allocation.h):
-  // every pass gives pixel p m_p in [spp, passSampleCap x spp] samples from
-  // an eye-only pilot, with at most passExtraSamples x spp x pixels above
-  // spp in all. 0: spp everywhere (the CLI's default for progressive renders
-  // is cli/progressive_options.h's kDefaultExtraSamples).
-  float passExtraSamples = 0;
-  int passSampleCap = 32;
-};
-
-struct RenderStats {
-  double seconds = 0;          // everything: photon passes, trees, rendering
-  double photonSeconds = 0;    // tracing + tree builds
-  uint64_t cameraSamples = 0;
-  size_t causticStored = 0, globalStored = 0;
-  uint64_t causticEmitted = 0, globalEmitted = 0;
-  double bytesPerPhoton = 0;
-  // The path tracer's caustic guide (render/caustic_guide.h): photons
-  // stored and emitted, its neighbour cache's bytes, seconds to build it all.
-  size_t guideStored = 0;
-  uint64_t guideEmitted = 0, guideBytes = 0;
-  size_t guideCells = 0, guideCellsFilled = 0;  // its neighbour cache's sub-cells: all, and filled by the render
-  double guideSeconds = 0;
-  uint64_t standardEstimates = 0, timeEstimates = 0;
-  int minSpp = 0, maxSpp = 0;  // over pixels
-  uint64_t peakResidentBytes = 0;  // of the whole process, at the end of render() (core/memory.h)
-  std::vector<std::string> warnings;  // for the user: empty photon maps and the like
-};
-
 // What the user should know before looking at the image: no lights and a
 // black background, lights of zero power (every render path reports them).
 std::vector<std::string> sceneWarnings(const Scene& scene);
 
-// Names of the methods the renderer accepts (for validation and --help).
-// The pixel filter the options ask for (its kind's default radius when
-// filterRadius is 0): every pixel loop (fixed budget, progressive pass,
-// animation frame) samples its camera positions from it.
-PixelFilter pixelFilterFor(const RenderOptions& opt);
-
-const char* const* renderMethods();
-bool isRenderMethod(const std::string& name);
 
 // Throws tdpm::Error, before any work, when the image and the photon maps
 // the options ask for cannot fit in the machine's available memory

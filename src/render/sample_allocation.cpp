@@ -4,8 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "core/rng.h"
+#include "render/camera_sample.h"
+#include "render/film.h"
+#include "render/pixel_loop.h"
 #include "render/photon_integrator.h"
 #include "render/pixel_share.h"
 #include "render/tile_loop.h"
@@ -22,48 +26,9 @@ struct PilotScratch {
   PhotonIntegrator::ThreadState state;
 };
 
-}  // namespace
-
-std::vector<float> pilotNoise(const Scene& scene, const RenderOptions& opt, const Progress& progress,
-                              dist::Comm& comm) {
-  const int w = scene.camera.width(), h = scene.camera.height();
+// The pilot's per-pixel luminance mean and variance -> each pixel's noise.
+std::vector<float> noiseFromPilot(std::vector<float> mean, std::vector<float> var, int w, int h) {
   const size_t n = size_t(w) * size_t(h);
-  // No maps and no final gather: emission through specular chains and
-  // direct light (light sampling at full weight), the eye side alone.
-  PhotonIntegratorSettings is;
-  is.timeDependent = false;
-  is.gatherRays = 0;
-  is.maxDepth = opt.maxDepth;
-  PhotonIntegrator eyeOnly(scene, nullptr, nullptr, is);
-  const PixelFilter filter = pixelFilterFor(opt);
-  const uint64_t seed = hashCombine(opt.seed, kPilotSeedSalt);
-  std::vector<float> mean(n, 0.0f), var(n, 0.0f);
-  forEachTile<PilotScratch>(w, h, "pilot", progress, [&](const Tile& t, PilotScratch& s) {
-    for (int y = t.y0; y < t.y1; ++y)
-      for (int x = t.x0; x < t.x1; ++x) {
-        size_t idx = size_t(y) * size_t(w) + size_t(x);
-        SobolPixelSampler ps(seed, idx);
-        double sum = 0, sq = 0;
-        for (uint32_t i = 0; i < uint32_t(kPilotSamples); ++i) {
-          CameraSample cs = ps.camera(i);
-          if (!scene.hasMotion) cs.time01 = 0.0f;
-          Vec3f o, d;
-          Vec2f p = filter.sample(cs.pixelOffset);
-          scene.camera.generateRay({float(x) + p.x, float(y) + p.y}, cs.time01, o, d);
-          SobolStream stream = ps.stream(i);
-          Rgb L = saturateSample(eyeOnly.radiance(o, d, cs.time01, stream, s.state));
-          double l = std::min(double(L.luminance()), 1e30);
-          sum += l;
-          sq += l * l;
-        }
-        double m = sum / kPilotSamples;
-        mean[idx] = float(m);
-        var[idx] = float(std::max(0.0, (sq - sum * m) / (kPilotSamples - 1)));
-      }
-  }, tileShareOf(comm));
-  sharePixels(comm, w, h, mean, true);
-  sharePixels(comm, w, h, var, true);
-
   double total = 0;
   for (float m : mean) total += double(m);
   const double floor = std::max(kNoiseFloorFraction * total / double(std::max<size_t>(n, 1)), 1e-30);
@@ -111,6 +76,50 @@ std::vector<float> pilotNoise(const Scene& scene, const RenderOptions& opt, cons
       noise[size_t(y) * size_t(w) + size_t(x)] = best;
     }
   return noise;
+}
+
+}  // namespace
+
+std::vector<float> pilotNoise(const Scene& scene, const RenderOptions& opt, const Progress& progress,
+                              dist::Comm& comm) {
+  const int w = scene.camera.width(), h = scene.camera.height();
+  const size_t n = size_t(w) * size_t(h);
+  // No maps and no final gather: emission through specular chains and
+  // direct light (light sampling at full weight), the eye side alone.
+  PhotonIntegratorSettings is;
+  is.timeDependent = false;
+  is.gatherRays = 0;
+  is.maxDepth = opt.maxDepth;
+  PhotonIntegrator eyeOnly(scene, nullptr, nullptr, is);
+  CameraSamplePlan plan{pixelFilterFor(opt), {}};
+  plan.times.moving = scene.hasMotion;
+  const uint64_t seed = hashCombine(opt.seed, kPilotSeedSalt);
+  std::vector<float> mean(n, 0.0f), var(n, 0.0f);
+  forEachTile<PilotScratch>(w, h, "pilot", progress, [&](const Tile& t, PilotScratch& s) {
+    double sum = 0, sq = 0;  // the pixel in flight's luminance sums
+    samplePixels<SobolPixelSampler>(
+        t, w, scene.camera, plan, seed,
+        [&](size_t, uint32_t& f, uint32_t& c) {
+          f = 0;
+          c = uint32_t(kPilotSamples);
+          sum = sq = 0;
+          return true;
+        },
+        [&](size_t, uint32_t, const CameraRay& ray, SobolStream& stream) {
+          Rgb L = saturateSample(eyeOnly.radiance(ray.origin, ray.direction, ray.time01, stream, s.state));
+          double l = std::min(double(L.luminance()), 1e30);
+          sum += l;
+          sq += l * l;
+        },
+        [&](size_t idx) {
+          double m = sum / kPilotSamples;
+          mean[idx] = float(m);
+          var[idx] = float(std::max(0.0, (sq - sum * m) / (kPilotSamples - 1)));
+        });
+  }, tileShareOf(comm));
+  sharePixels(comm, w, h, mean, true);
+  sharePixels(comm, w, h, var, true);
+  return noiseFromPilot(std::move(mean), std::move(var), w, h);
 }
 
 std::vector<uint32_t> allocatePassSamples(const std::vector<float>& noise, int spp, int cap, double budget) {

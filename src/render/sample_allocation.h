@@ -20,7 +20,7 @@
 
 #include "core/progress.h"
 #include "dist/comm.h"
-#include "render/renderer.h"
+#include "render/render_options.h"
 #include "scene/scene.h"
 
 namespace tdpm {

@@ -23,6 +23,7 @@
 #include "scene/mesh_obj.h"
 #include "scene/parse_animation.h"
 #include "scene/parse_node.h"
+#include "scene/render_method.h"
 
 namespace tdpm::scene {
 
@@ -673,8 +674,6 @@ uint64_t readSeed(const Node& n) {
   return uint64_t(d);
 }
 
-const std::vector<std::string> kMethods = {"pathtrace", "static", "accumulation", "standard", "time"};
-
 const std::vector<std::string> kSearches = {"twopass", "4d"};
 const std::vector<std::string> kSamplers = {"random", "sobol"};
 const std::vector<std::string> kFilters = {"box", "gaussian"};
@@ -686,7 +685,7 @@ RenderSettings readRender(const Node& n, float shutterLength) {
                   "frames", "search", "k", "fraction", "kappa", "max_radius", "max_dt", "kernel_space", "kernel_time",
                   "gather", "sampler", "filter", "filter_radius", "progressive", "passes", "time_limit"});
   RenderSettings r;
-  if (n.has("method")) r.method = n.member("method").choice(kMethods, "render method");
+  if (n.has("method")) r.method = n.member("method").choice(renderMethodNames(), "render method");
   if (n.has("spp")) r.spp = readCount(n.member("spp"), "spp", limits::kSpp);
   if (n.has("max_spp")) r.maxSpp = readCount(n.member("max_spp"), "max_spp", limits::kSpp);
   if (n.has("contrast")) r.contrast = readPositive(n.member("contrast"), "contrast");
