@@ -143,6 +143,9 @@ class Gatherer {
  public:
   Gatherer(const photon::KdTree& tree, const Options& options);
   const Options& options() const { return opt_; }
+  // Photons the last estimate's sum ran over (before the side and surface
+  // tests; the boundary photon left out); 0 if none were found.
+  int lastSummed() const { return lastSummed_; }
 
   // minVolume: TimeTwoPass and SpaceTime4D, the smallest space-time kernel
   // volume (scene units^2 x seconds) the query should use; 0: none (see
@@ -228,6 +231,7 @@ class Gatherer {
   photon::KnnQuery query_;
   std::vector<uint8_t> bins_;  // candidates' time bins, padded for SIMD
   std::vector<int> kept_;      // positions of the kept candidates
+  int lastSummed_ = 0;
 };
 
 // ---------------------------------------------------------------------------
@@ -237,6 +241,7 @@ Rgb Gatherer::standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, 
                            uint8_t surfaceTag) {
   const photon::PhotonStore& s = tree_->store();
   float maxR2 = opt_.maxRadius * opt_.maxRadius;
+  lastSummed_ = 0;
   int found = tree_->knn(x, opt_.k, maxR2, query_);
   if (report) {
     *report = Report{};
@@ -248,6 +253,7 @@ Rgb Gatherer::standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, 
   float r2 = ballRadius2(found, opt_.k, maxR2);
   float invR2 = 1.0f / r2;
   const int first = boundaryFirst(found, opt_.k, maxR2);  // the k-th is on the boundary
+  lastSummed_ = found - first;
   const uint32_t* idx = query_.index();
   const float* d2 = query_.dist2();
   const uint16_t* dirs = s.directions();
@@ -281,6 +287,7 @@ Rgb Gatherer::twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf
   const uint16_t* flags = s.flags();
   const float u = tq.binUnits(t);
   if (report) *report = Report{};
+  lastSummed_ = 0;
   int ks = opt_.ks, found = 0, nc = 0;
   float r2 = 0.0f, h = 0.0f, invH = 0.0f, volume = 0.0f;
   uint8_t* bins = nullptr;
@@ -357,6 +364,7 @@ Rgb Gatherer::twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf
     kept[m] = i;
     m += int(unsigned(bins[i]) - lo8 <= width8);
   }
+  lastSummed_ = m;
   // ---- slice correction ----
   // A photon of time t_p lies on the surface as it was at t_p. If the
   // surface moved along its normal, that copy is offset by
@@ -405,6 +413,7 @@ Rgb Gatherer::spaceTime4D(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf,
   const photon::PhotonStore& s = tree_->store();
   const photon::TimeQuantiser& tq = s.time();
   t = std::min(std::max(t, tq.t0), tq.t1);
+  lastSummed_ = 0;
   float maxD2 = opt_.maxRadius * opt_.maxRadius;
   const uint16_t* flags = s.flags();
   const double kappa = tree_->kappa();
@@ -438,6 +447,7 @@ Rgb Gatherer::spaceTime4D(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf,
   }
   // The k-th photon closes the ellipsoid: (k-1) inside it (header).
   const int first = boundaryFirst(found, k, maxD2);
+  lastSummed_ = found - first;
   if (report) {
     *report = Report{};
     report->candidates = found;

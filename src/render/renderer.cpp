@@ -433,6 +433,16 @@ bool isRenderMethod(const std::string& name) {
   return false;
 }
 
+namespace {
+// The per-map k-NN estimate counts of one integrator into the stats.
+void addMapCounts(RenderStats& st, const EstimateCounts& c) {
+  st.causticEstimates += c.caustic;
+  st.globalEstimates += c.global;
+  st.fewCausticEstimates += c.fewCaustic;
+  st.fewGlobalEstimates += c.fewGlobal;
+}
+}  // namespace
+
 Film render(const Scene& scene, const RenderOptions& opt, const Progress& progress, RenderStats& st, dist::Comm& comm) {
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
   if (!isRenderMethod(opt.method)) throw Error("unknown method '" + opt.method + "'");
@@ -488,6 +498,7 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
       renderPixels(scene, integ, framePlan, stage.c_str(), progress, one);
       EstimateCounts c = integ.counts();
       st.standardEstimates += c.standard;
+      addMapCounts(st, c);
       for (size_t i = 0; i < sum.color.size(); ++i) {
         sum.color[i] += one.color[i];
         sum.sampleCount[i] += one.sampleCount[i];
@@ -511,6 +522,7 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
     EstimateCounts c = integ.counts();
     st.standardEstimates = c.standard;
     st.timeEstimates = c.timeDependent;
+    addMapCounts(st, c);
   }
   if (comm.distributed()) {
     // Rank 0 gathers the film; estimate counts are summed (integers).
@@ -518,10 +530,15 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
     sharePixels(comm, film.width, film.height, film.color, false, owners);
     sharePixels(comm, film.width, film.height, film.sampleCount, false, owners);
     sharePixels(comm, film.width, film.height, film.varianceOfMean, false, owners);
-    uint64_t counts[2] = {st.standardEstimates, st.timeEstimates};
-    comm.allreduceSum(counts, 2);
+    uint64_t counts[6] = {st.standardEstimates, st.timeEstimates, st.causticEstimates,
+                          st.globalEstimates, st.fewCausticEstimates, st.fewGlobalEstimates};
+    comm.allreduceSum(counts, 6);
     st.standardEstimates = counts[0];
     st.timeEstimates = counts[1];
+    st.causticEstimates = counts[2];
+    st.globalEstimates = counts[3];
+    st.fewCausticEstimates = counts[4];
+    st.fewGlobalEstimates = counts[5];
   }
   finishStats(film, st);
   st.seconds = timer.seconds();
@@ -552,6 +569,7 @@ Film renderFrame(const Scene& scene, const RenderOptions& opt, const FrameInput&
     EstimateCounts c = integ.counts();
     st.standardEstimates = c.standard;
     st.timeEstimates = c.timeDependent;
+    addMapCounts(st, c);
   }
   finishStats(film, st);
   st.seconds = timer.seconds();
