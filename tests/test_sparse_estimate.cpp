@@ -42,6 +42,7 @@
 #include "photon/temporal_select.h"
 #include "render/renderer.h"
 #include "scene/parse.h"
+#include "scene_fixtures.h"
 
 using namespace tdpm;
 using namespace tdpm::estimate;
@@ -185,7 +186,9 @@ const int kSizes[] = {2, 3, 4, 5, 6, 8, 9, 10, 12, 16, 17, 24, 32, 64, 128, 512,
 
 // Queries per size: enough for the mean's error (the estimate's relative
 // spread is ~1/sqrt(n-1), infinite variance at n = 2) to be well below 2%.
-int queryCount(int n) { return std::clamp(600000 / n, 3000, 150000); }
+// Above ~500 the map's own fluctuation over the query region (~0.3%)
+// dominates, so 1,000 queries do.
+int queryCount(int n) { return std::clamp(600000 / n, 1000, 150000); }
 
 void checkSet(Set set, Method method, uint64_t seed, bool centreTime) {
   static SetMaps maps[3];
@@ -226,11 +229,11 @@ TEST_CASE("sparse estimates: two-pass, a moving caustic line") {
   checkSet(Set::Moving, Method::TimeTwoPass, 5, false);
 }
 
-TEST_CASE("sparse estimates: 4D, uniform, a gradient in time and a moving caustic line") {
-  checkSet(Set::Uniform, Method::SpaceTime4D, 6, false);
-  checkSet(Set::Ramp, Method::SpaceTime4D, 7, false);
-  checkSet(Set::Moving, Method::SpaceTime4D, 8, false);
-}
+TEST_CASE("sparse estimates: 4D, uniform") { checkSet(Set::Uniform, Method::SpaceTime4D, 6, false); }
+
+TEST_CASE("sparse estimates: 4D, a gradient in time") { checkSet(Set::Ramp, Method::SpaceTime4D, 7, false); }
+
+TEST_CASE("sparse estimates: 4D, a moving caustic line") { checkSet(Set::Moving, Method::SpaceTime4D, 8, false); }
 
 TEST_CASE("sparse estimates: a maximum time distance gives a known window (count over it)") {
   static SetMaps m;
@@ -311,4 +314,47 @@ TEST_CASE("sparse estimates: --stats counts the estimates from few photons, per 
   CHECK(st.globalEstimates > 0);
   CHECK(st.fewGlobalEstimates == 0);
   CHECK(st.fewCausticEstimates == 0);
+}
+
+namespace {
+// scenes/static-room.json with tall_block moving from x-0.4 to x+0.4 over
+// the shutter, the global map seen directly (--global-direct --gather 0
+// --photons 0), 80x60, 8 spp: image mean.
+double movingRoomMean(const std::string& method, size_t globalPhotons) {
+  scene::SceneDescription d = scene::loadScene(std::string(TDPM_SOURCE_DIR) + "/scenes/static-room.json");
+  for (scene::ObjectDesc& o : d.objects)
+    if (o.name == "tall_block") o.motion = test::translation({-0.4f, 0, 0}, {0.4f, 0, 0});
+  d.camera.width = 80;
+  d.camera.height = 60;
+  auto scene = Scene::build(d);
+  RenderOptions o;
+  o.method = method;
+  o.spp = 8;
+  o.seed = 2;
+  o.causticPhotons = 0;
+  o.globalPhotons = globalPhotons;
+  o.gatherRays = 0;
+  o.visualizeGlobal = true;
+  RenderStats st;
+  Film f = render(*scene, o, Progress{}, st);
+  double sum = 0.0;
+  for (const Rgb& c : f.color) sum += c.average();
+  return sum / double(f.color.size());
+}
+}  // namespace
+
+// Issue 24's own scene: time over standard was 1.343 at 2,000 global
+// photons and 1.060 at 100,000 (a bias that grew as photons got sparse);
+// now 1.046 and 1.055. The ~5% left at every count is on the moving block,
+// where the standard estimate is the wrong one (it reads the block's
+// photons of the whole shutter; against a path-traced reference the full
+// render's block is 1.004 with time, 0.966 with standard: docs/photon-map.md).
+// So the test asserts what the fix is about: the ratio no longer depends on
+// the photon count.
+TEST_CASE("sparse estimates: the moving static-room's global map, time over standard does not grow as photons get few") {
+  double sparse = movingRoomMean("time", 2000) / movingRoomMean("standard", 2000);
+  double dense = movingRoomMean("time", 100000) / movingRoomMean("standard", 100000);
+  MESSAGE("time / standard: 2,000 global photons " << sparse << ", 100,000 " << dense);
+  CHECK(std::fabs(sparse - dense) < 0.03);
+  CHECK(sparse < 1.08);
 }
