@@ -46,9 +46,10 @@
 //    window is whole bins rather than 2 max |t_p - t| with bin centres.
 //    The window is defined by the m-th kept photon, so the estimate counts
 //    m - 1 photons over the expected window the m-th one closes
-//    (timeWindowCorrection); with fewer than kMinTimePhotons to keep, or
-//    all candidates to keep, the window is the whole shutter (known: plain
-//    count over its length).
+//    (timeWindowCorrection); where kMinTimePhotons would be all the
+//    candidates, the window is the known one (the bins within
+//    maxTimeDistance, or the whole shutter) and the estimate the plain
+//    count over it; so it is where maxTimeDistance cut the window short.
 //  * Two-pass minimum kernel volume (the eye sample's share of its pixel):
 //    radiance(..., minVolume) asks that the space-time kernel pi r^2 h N be
 //    at least minVolume (scene units^2 x seconds). Where photons bunch (a
@@ -84,7 +85,7 @@ constexpr float kMaxSliceWeight = 2.0f;
 // Fewest photons the two-pass estimate keeps in time (a "handful"). With m
 // kept the m-th defines the window and the estimate is (m-1) / window: its
 // upper tail falls as x^-m (P(window < x) ~ x^m), so a floor on m bounds
-// the 99.9th percentile; below it the window is the whole shutter.
+// the 99.9th percentile; below it the window is the known one (header).
 constexpr int kMinTimePhotons = 8;
 
 // Photons an estimate is said to come from "few" of (--stats).
