@@ -190,7 +190,8 @@ const int kSizes[] = {2, 3, 4, 5, 6, 8, 9, 10, 12, 16, 17, 24, 32, 64, 128, 512,
 // dominates, so 1,000 queries do.
 int queryCount(int n) { return std::clamp(600000 / n, 1000, 150000); }
 
-void checkSet(Set set, Method method, uint64_t seed, bool centreTime) {
+// The sets, built once for every test case that reads them.
+const SetMaps& setMaps(Set set) {
   static SetMaps maps[3];
   static bool built[3] = {false, false, false};
   int si = int(set);
@@ -198,10 +199,16 @@ void checkSet(Set set, Method method, uint64_t seed, bool centreTime) {
     makeSet(maps[si], set, 100 + uint64_t(si));
     built[si] = true;
   }
+  return maps[si];
+}
+
+void checkSet(Set set, Method method, uint64_t seed, bool centreTime) {
+  const int si = int(set);
+  const SetMaps& map = setMaps(set);
   for (int n : kSizes) {
     CAPTURE(n);
     std::vector<Q> qs = queries(set, method, queryCount(n), seed + uint64_t(n), centreTime);
-    Result res = run(maps[si], method, n, qs);
+    Result res = run(map, method, n, qs);
     double bound = boundFor(method, n, 0.5f);
     MESSAGE("set " << si << " method " << int(method) << " n " << n << ": mean " << res.mean << " p99.9 "
                    << res.p999 << " (bound " << bound << ", " << res.count << " queries)");
@@ -236,8 +243,7 @@ TEST_CASE("sparse estimates: 4D, a gradient in time") { checkSet(Set::Ramp, Meth
 TEST_CASE("sparse estimates: 4D, a moving caustic line") { checkSet(Set::Moving, Method::SpaceTime4D, 8, false); }
 
 TEST_CASE("sparse estimates: a maximum time distance gives a known window (count over it)") {
-  static SetMaps m;
-  makeSet(m, Set::Uniform, 200);
+  const SetMaps& m = setMaps(Set::Uniform);
   for (int n : {2, 9, 16, 64, 512}) {
     CAPTURE(n);
     std::vector<Q> qs = queries(Set::Uniform, Method::TimeTwoPass, queryCount(n), 40 + uint64_t(n), false);
