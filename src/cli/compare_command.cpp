@@ -91,7 +91,8 @@ nlohmann::ordered_json channelsJson(const ImageMetrics& m, double image::Channel
 }
 
 void printText(const CompareArgs& a, const image::LoadedImage& testFile, const image::LoadedImage& refFile,
-               const ImageMetrics& m, const std::optional<image::RowProfile>& profile) {
+               const ImageMetrics& m, const std::optional<image::RowProfile>& profile,
+               const std::optional<image::SaltMetrics>& salt) {
   const image::ImageRgb& test = testFile.color;
   std::printf("test:      %s (%s, %s)\n", a.test.c_str(), sizeText(test).c_str(), image::formatName(testFile.format));
   std::printf("reference: %s (%s, %s)\n", a.reference.c_str(), sizeText(test).c_str(),
@@ -123,6 +124,9 @@ void printText(const CompareArgs& a, const image::LoadedImage& testFile, const i
   else
     std::printf("\nmean difference: n/a (reference is black)\n");
   std::printf("relMSE = mean (test - ref)^2 / (ref + 0.01)^2, as pbrt-v4's MRSE\n");
+  if (salt)
+    std::printf("salt: %zu pixels (%.4f%%) above 3x both 5x5 medians (reference's and test's)\n", salt->count,
+                100.0 * salt->share);
   if (profile) {
     ProfileSummary s = summarize(*profile);
     std::printf("\nprofile row %d, x %d..%d: peak luminance test %.6g at x=%d, ref %.6g at x=%d; mean test %.6g, ref %.6g\n",
@@ -134,7 +138,8 @@ void printText(const CompareArgs& a, const image::LoadedImage& testFile, const i
 }
 
 void printJson(const CompareArgs& a, const image::LoadedImage& testFile, const image::LoadedImage& refFile,
-               const ImageMetrics& m, const std::optional<image::RowProfile>& profile) {
+               const ImageMetrics& m, const std::optional<image::RowProfile>& profile,
+               const std::optional<image::SaltMetrics>& salt) {
   using json = nlohmann::ordered_json;
   using CM = image::ChannelMetrics;
   const image::ImageRgb& test = testFile.color;
@@ -158,6 +163,10 @@ void printJson(const CompareArgs& a, const image::LoadedImage& testFile, const i
   j["relative_mean_difference"] = d ? json(*d) : json(nullptr);
   j["nonfinite_values"] = {{"test", m.nonFiniteTest}, {"reference", m.nonFiniteRef}};
   j["rel_mse_definition"] = "mean over pixels of (test - ref)^2 / (ref + 0.01)^2 per channel (pbrt-v4 MRSE)";
+  if (salt)
+    j["salt"] = {{"count", salt->count},
+                 {"share", salt->share},
+                 {"definition", "pixels whose luminance is above 3x both the reference's and the test's own 5x5 median"}};
   if (profile) {
     ProfileSummary s = summarize(*profile);
     j["profile"] = {{"row", profile->y},
@@ -184,6 +193,9 @@ CLI::App* addCompareCommand(CLI::App& app, CompareArgs& a) {
       ->required();
   c->add_option("reference", a.reference, "Reference image, same size, in any of those formats")->required();
   c->add_flag("--json", a.json, "Print the metrics as one JSON object instead of a table");
+  c->add_flag("--salt", a.salt,
+              "Also count salt: pixels whose luminance is above 3x both the reference's and the test's own 5x5 "
+              "median (count and share of the region's pixels; in --json as \"salt\")");
   c->add_flag("--allow-nonfinite", a.allowNonFinite,
               "Measure images with NaN or infinite values (counted as 0 and reported per image) instead of "
               "refusing them");
@@ -297,6 +309,8 @@ int runCompare(const CompareArgs& a) {
     }
 
   ImageMetrics m = image::compareImages(test.color, ref.color, crop);
+  std::optional<image::SaltMetrics> salt;
+  if (a.salt) salt = image::countSalt(test.color, ref.color, region);
 
   // Both profile files or neither, committed together: on any failure the
   // previous pair (if any) stays as it was.
@@ -316,8 +330,8 @@ int runCompare(const CompareArgs& a) {
   if (m.nonFiniteTest || m.nonFiniteRef)
     std::fprintf(stderr, "tdpm: warning: %zu non-finite values in %s and %zu in %s were counted as 0\n",
                  m.nonFiniteTest, a.test.c_str(), m.nonFiniteRef, a.reference.c_str());
-  if (a.json) printJson(a, test, ref, m, profile);
-  else printText(a, test, ref, m, profile);
+  if (a.json) printJson(a, test, ref, m, profile, salt);
+  else printText(a, test, ref, m, profile, salt);
   return 0;
 }
 

@@ -22,6 +22,7 @@ struct CompareArgs {
   std::optional<int> profileRow;
   std::optional<std::string> csv;
   std::optional<std::string> plot;
+  bool salt = false;  // --salt: isolated bright outliers (image::countSalt)
 };
 
 CLI::App* addCompareCommand(CLI::App& app, CompareArgs& args);

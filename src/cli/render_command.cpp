@@ -132,6 +132,11 @@ void printStats(const RenderStats& st) {
   std::fprintf(stderr, "  render: %.3f s\n", std::max(0.0, st.seconds - st.photonSeconds));
   std::fprintf(stderr, "  estimates: %llu time-dependent, %llu standard\n", u(st.timeEstimates),
                u(st.standardEstimates));
+  // Issue 24: where an estimate reads few photons it is noisy (and was biased).
+  if (st.causticEstimates + st.globalEstimates > 0)
+    std::fprintf(stderr, "  estimates from fewer than %d photons: caustic %llu of %llu, global %llu of %llu\n",
+                 estimate::kFewPhotons, u(st.fewCausticEstimates), u(st.causticEstimates), u(st.fewGlobalEstimates),
+                 u(st.globalEstimates));
   std::fprintf(stderr, "  samples per pixel: %d-%d\n", st.minSpp, st.maxSpp);
 }
 

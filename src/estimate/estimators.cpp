@@ -1,6 +1,6 @@
 // estimate/estimators.cpp — the non-template parts of the estimators: the
-// per-thread gatherer's set-up and the clipped space-time volume of the 4D
-// estimate.
+// per-thread gatherer's set-up, the clipped space-time volume of the 4D
+// estimate and the two-pass small-count factor.
 #include "estimate/estimators.h"
 
 #include <algorithm>
@@ -31,14 +31,44 @@ Gatherer::Gatherer(const photon::KdTree& tree, const Options& options)
 //     V = pi * integral_a^b (d^2 - kappa s^2) ds
 //       = pi * [ d^2 (b - a) - kappa (b^3 - a^3) / 3 ].
 // Unclipped (a = -b = d/sqrt(kappa)): V = 4/3 pi d^3 / sqrt(kappa), the
-// ellipsoid. The estimate clips [a, b] to the time range of the photons
-// found (their bins) and to the shutter: where photons cluster in time, no
-// photon can lie outside that range, and counting that empty volume would
-// blur time.
+// ellipsoid. The estimate clips [a, b] to the shutter only, where photons
+// can be: clipping it to the photons' own time range (as it once did)
+// divides by a volume the photons define and overestimates where they are
+// few (docs/photon-map.md, "Few photons").
 double clippedEllipsoidVolume(double d2, double kappa, double a, double b) {
   if (!(b > a) || !(d2 > 0.0) || !(kappa > 0.0)) return 0.0;
   double v = kPi * (d2 * (b - a) - kappa * (b * b * b - a * a * a) / 3.0);
   return v > 0.0 ? v : 0.0;
+}
+
+
+// The two-pass small-count factor (header; docs/photon-map.md, "Few
+// photons"). The window grows outward from the query in a fixed order of
+// bins; give the photons of each step virtual positions uniform over the
+// step's measure. They are then a Poisson (or, given the candidates, a
+// binomial) process in measure, the window closes at the step holding the
+// m-th arrival X_m, and (m - 1) / X_m has mean the rate for any m >= 2 (the
+// continuous k-NN result: X_m ~ Gamma(m), E[1/X_m] = rate / (m - 1)). X_m is
+// not known, only that it is the j-th of the C photons of the last step:
+// X_m = a + w B, B ~ Beta(j, C - j + 1), and its mean inverse is taken
+// exactly for a = 0 (E[1/B] = C / (j - 1)) and to second order otherwise
+// (a >= 1 bin, so the third-order term is below 0.3% for one-bin steps).
+// The estimate is the mean photon of the window times that rate.
+double timeWindowCorrection(int m, int windowBins, int kept, int prevBins, int prevKept) {
+  const double a = double(prevBins), w = double(windowBins - prevBins);
+  const int C = kept - prevKept, j = m - prevKept;
+  if (m < 2 || C < 1 || j < 1 || j > C || !(w > 0.0) || kept < 1) return 1.0;  // not a photon-defined window
+  double g;
+  if (a == 0.0) {
+    if (j < 2) return 1.0;
+    g = double(C) / (double(j - 1) * w);
+  } else {
+    const double c1 = double(C + 1);
+    const double mu = a + w * double(j) / c1;
+    const double var = w * w * double(j) * double(C - j + 1) / (c1 * c1 * double(C + 2));
+    g = 1.0 / mu + var / (mu * mu * mu);
+  }
+  return double(m - 1) * g * double(windowBins) / double(kept);
 }
 
 }  // namespace tdpm::estimate

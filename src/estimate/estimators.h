@@ -26,6 +26,15 @@
 //    photon within maxRadius was found and r = maxRadius (if maxRadius is
 //    infinite, the farthest found). r^2 is at least minRadius2, so
 //    coincident photons give a large but finite value, never NaN.
+//  * Small counts (docs/photon-map.md, "Few photons"): where a photon's
+//    distance defines the radius (the k-th, or the farthest when the map
+//    holds fewer than k), that photon lies on the boundary, not inside: it
+//    is left out of the sum (and out of the two-pass time selection), so
+//    the estimate is (k-1) photons over the volume the k-th defines, whose
+//    mean is the density for any k (k / volume has mean k/(k-1) times it).
+//    Where the search stopped at maxRadius nothing is left out: the photons
+//    of a known disc were all counted. The same holds in time (two-pass)
+//    and in space-time (4D).
 //  * Time: the 8-bit bins of photon/store.h. Two-pass: the window is the kept
 //    bins [lo, hi] (photon/temporal_select.h; ties kept whole), i.e. the
 //    interval [lo, hi + 1) in bin units, which lies inside the shutter by
@@ -35,6 +44,12 @@
 //    N = integral of K2 over [a, b] (= b - a for uniform: the volume is
 //    pi r^2 times the window length). See docs/photon-map.md for why the
 //    window is whole bins rather than 2 max |t_p - t| with bin centres.
+//    The window is defined by the m-th kept photon, so the estimate counts
+//    m - 1 photons over the expected window the m-th one closes
+//    (timeWindowCorrection); where kMinTimePhotons would be all the
+//    candidates, the window is the known one (the bins within
+//    maxTimeDistance, or the whole shutter) and the estimate the plain
+//    count over it; so it is where maxTimeDistance cut the window short.
 //  * Two-pass minimum kernel volume (the eye sample's share of its pixel):
 //    radiance(..., minVolume) asks that the space-time kernel pi r^2 h N be
 //    at least minVolume (scene units^2 x seconds). Where photons bunch (a
@@ -67,6 +82,25 @@ enum class Method : unsigned char { Standard, TimeTwoPass, SpaceTime4D };
 // twoPassImpl): photons at |delta| > r sqrt(1 - 1/2) are under-corrected.
 constexpr float kMaxSliceWeight = 2.0f;
 
+// Fewest photons the two-pass estimate keeps in time (a "handful"). With m
+// kept the m-th defines the window and the estimate is (m-1) / window: its
+// upper tail falls as x^-m (P(window < x) ~ x^m), so a floor on m bounds
+// the 99.9th percentile; below it the window is the known one (header).
+constexpr int kMinTimePhotons = 8;
+
+// Photons an estimate is said to come from "few" of (--stats).
+constexpr int kFewPhotons = 8;
+
+// The two-pass small-count factor (docs/photon-map.md, "Few photons"): the
+// window [lo, hi] of `kept` photons was closed by the m-th nearest in time;
+// `prevBins` / `prevKept`: the bins strictly nearer than the window's outer
+// bins and the photons in them (< m). Returns c such that the estimate
+// (sum / window) x c = sum / kept x (m - 1) x E[1 / X_m | bin counts], X_m
+// the measure (in bins) at which the m-th photon arrives when the window
+// grows bin by bin: (m - 1) / X_m is unbiased for a Poisson or binomial
+// process, and its mean given the counts is taken to second order.
+double timeWindowCorrection(int m, int windowBins, int kept, int prevBins, int prevKept);
+
 struct Options {
   Method method = Method::TimeTwoPass;
   int k = 100;              // Standard and SpaceTime4D: photons in the estimate
@@ -91,7 +125,8 @@ struct Report {
   int kept = 0;                // TimeTwoPass: inside the time window (either side)
   float radius2 = 0.0f;        // r^2 (4D: d^2 of the metric)
   float windowLo = 0.0f, windowHi = 0.0f;  // time window, seconds (Standard: the shutter)
-  float volume = 0.0f;         // the denominator: pi r^2 ts, pi r^2 h N, or V
+  float volume = 0.0f;         // the denominator: pi r^2 ts, pi r^2 h N / c, or V
+  int summed = 0;              // photons the sum ran over (boundary photon left out)
 };
 
 // A BRDF that is the same for all directions (Lambertian: albedo / pi).
@@ -109,6 +144,9 @@ class Gatherer {
  public:
   Gatherer(const photon::KdTree& tree, const Options& options);
   const Options& options() const { return opt_; }
+  // Photons the last estimate's sum ran over (before the side and surface
+  // tests; the boundary photon left out); 0 if none were found.
+  int lastSummed() const { return lastSummed_; }
 
   // minVolume: TimeTwoPass and SpaceTime4D, the smallest space-time kernel
   // volume (scene units^2 x seconds) the query should use; 0: none (see
@@ -168,6 +206,21 @@ class Gatherer {
     float r2 = found == k ? query_.radius2 : (std::isfinite(maxR2) ? maxR2 : query_.maxFound2);
     return r2 > opt_.minRadius2 ? r2 : opt_.minRadius2;
   }
+  // The photon whose distance defines the radius, moved to slot 0: returns
+  // 1 (skip slot 0) if there is one, 0 if the search stopped at the maximum
+  // radius (every photon of a known ball found). See header.
+  int boundaryFirst(int found, int k, float maxR2) {
+    if (found == k) return 1;  // full heap: the root is the farthest
+    if (std::isfinite(maxR2) || found == 0) return 0;
+    uint32_t* idx = query_.index();
+    float* d2 = query_.dist2();
+    int far = 0;
+    for (int i = 1; i < found; ++i)
+      if (d2[i] > d2[far]) far = i;
+    std::swap(idx[0], idx[far]);
+    std::swap(d2[0], d2[far]);
+    return 1;
+  }
   template <class K1, class Brdf>
   Rgb standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, Report* report, uint8_t surfaceTag);
   template <class K2, class K1, class Brdf>
@@ -179,6 +232,7 @@ class Gatherer {
   photon::KnnQuery query_;
   std::vector<uint8_t> bins_;  // candidates' time bins, padded for SIMD
   std::vector<int> kept_;      // positions of the kept candidates
+  int lastSummed_ = 0;
 };
 
 // ---------------------------------------------------------------------------
@@ -188,6 +242,7 @@ Rgb Gatherer::standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, 
                            uint8_t surfaceTag) {
   const photon::PhotonStore& s = tree_->store();
   float maxR2 = opt_.maxRadius * opt_.maxRadius;
+  lastSummed_ = 0;
   int found = tree_->knn(x, opt_.k, maxR2, query_);
   if (report) {
     *report = Report{};
@@ -198,13 +253,15 @@ Rgb Gatherer::standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, 
   if (found == 0) return Rgb(0.0f);
   float r2 = ballRadius2(found, opt_.k, maxR2);
   float invR2 = 1.0f / r2;
+  const int first = boundaryFirst(found, opt_.k, maxR2);  // the k-th is on the boundary
+  lastSummed_ = found - first;
   const uint32_t* idx = query_.index();
   const float* d2 = query_.dist2();
   const uint16_t* dirs = s.directions();
   const uint32_t* energies = s.energies();
   const uint16_t* flags = s.flags();
   Rgb sum(0.0f);
-  for (int i = 0; i < found; ++i) {
+  for (int i = first; i < found; ++i) {
     uint32_t p = idx[i];
     Vec3f wi = photon::decodeDirection(dirs[p]);
     if (!(dot(n, wi) > 0.0f)) continue;
@@ -217,6 +274,7 @@ Rgb Gatherer::standardImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, const Brdf& brdf, 
     report->radius2 = r2;
     report->volume = volume;
     report->kept = found;
+    report->summed = found - first;
   }
   return sum * (1.0f / volume);
 }
@@ -230,35 +288,65 @@ Rgb Gatherer::twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf
   const uint16_t* flags = s.flags();
   const float u = tq.binUnits(t);
   if (report) *report = Report{};
-  int ks = opt_.ks, found = 0;
+  lastSummed_ = 0;
+  int ks = opt_.ks, found = 0, nc = 0;
   float r2 = 0.0f, h = 0.0f, invH = 0.0f, volume = 0.0f;
   uint8_t* bins = nullptr;
+  const uint32_t* idx = nullptr;
+  const float* d2 = nullptr;
   photon::TimeWindow win;
+  const float maxDistBins = opt_.maxTimeDistance * tq.invBinWidth;
   // At most twice: the k_s nearest, then (if the kernel is smaller than
   // minVolume and the search was not stopped by the maximum radius) again
   // with k_s grown by the missing volume ratio (see the header comment).
   for (int attempt = 0;; ++attempt) {
-    // ---- pass 1: k_s nearest in space ----
+    // ---- pass 1: k_s nearest in space; the k_s-th closes the disc ----
     found = tree_->knn(x, ks, maxR2, query_);
     if (report) report->candidates = found;
     if (found == 0) return Rgb(0.0f);
     r2 = ballRadius2(found, ks, maxR2);
-    const uint32_t* idx = query_.index();
-    if (bins_.size() < size_t(found) + photon::kSelectPadding) bins_.resize(size_t(found) + photon::kSelectPadding);
-    if (kept_.size() < size_t(found)) kept_.resize(size_t(found));
+    const int first = boundaryFirst(found, ks, maxR2);
+    nc = found - first;  // candidates strictly inside the disc
+    if (nc == 0) return Rgb(0.0f);
+    idx = query_.index() + first;
+    d2 = query_.dist2() + first;
+    if (bins_.size() < size_t(nc) + photon::kSelectPadding) bins_.resize(size_t(nc) + photon::kSelectPadding);
+    if (kept_.size() < size_t(nc)) kept_.resize(size_t(nc));
     bins = bins_.data();
-    for (int i = 0; i < found; ++i) bins[i] = uint8_t(flags[idx[i]] & photon::kTimeMask);
+    for (int i = 0; i < nc; ++i) bins[i] = uint8_t(flags[idx[i]] & photon::kTimeMask);
     // ---- pass 2: the fraction f nearest in time (whole bins) ----
-    int keep = photon::keptCount(opt_.fraction, found);
-    win = photon::selectTimeWindow(bins, found, u, keep, opt_.maxTimeDistance * tq.invBinWidth);
+    // At least kMinTimePhotons; if that is all of them, the window is the
+    // known one (the shutter, or the bins within maxTimeDistance) and the
+    // estimate is the plain count over it (header: "Few photons").
+    const int keep = std::max(photon::keptCount(opt_.fraction, nc), kMinTimePhotons);
+    double c = 1.0;  // small-count factor of a photon-defined window
+    if (keep >= nc) {
+      win = photon::binsWithinKey(u, std::isfinite(maxDistBins) ? 2.0f * maxDistBins : maxDistBins);
+      if (win.empty()) return Rgb(0.0f);
+      win.kept = 0;
+      for (int i = 0; i < nc; ++i) win.kept += int(win.contains(bins[i]));
+    } else {
+      win = photon::selectTimeWindow(bins, nc, u, keep, maxDistBins);
+      if (win.empty()) return Rgb(0.0f);
+      if (win.kept >= keep) {
+        // The keep-th photon closed the window: the bins strictly nearer
+        // than its outer bins, and the photons in them.
+        float outer = std::max(photon::timeKey(win.lo, u), photon::timeKey(win.hi, u));
+        photon::TimeWindow prev = photon::binsWithinKey(u, std::nextafter(outer, 0.0f));
+        int prevKept = 0;
+        if (!prev.empty())
+          for (int i = 0; i < nc; ++i) prevKept += int(prev.contains(bins[i]));
+        c = timeWindowCorrection(keep, win.hi - win.lo + 1, win.kept, prev.empty() ? 0 : prev.hi - prev.lo + 1,
+                                 prevKept);
+      }  // else: cut by maxTimeDistance, a known window
+    }
     if (report) report->kept = win.kept;
-    if (win.empty()) return Rgb(0.0f);
     // ---- the cylinder: disc pi r^2 times the clipped window ----
     float lo = float(win.lo), hi1 = float(win.hi + 1);
     h = std::max(u - lo, hi1 - u);  // >= 0.5: u lies in [lo, hi + 1]
     invH = 1.0f / h;
     float norm = K2::integral((lo - u) * invH, (hi1 - u) * invH);
-    volume = kPi * r2 * (h * tq.binWidth) * norm;
+    volume = float(double(kPi * r2 * (h * tq.binWidth) * norm) / c);
     if (attempt > 0 || !(volume < minVolume) || found < ks) break;
     const int maxKs = opt_.ks * std::max(1, opt_.maxGrowth);
     const double grown = std::ceil(double(ks) * double(minVolume) / double(volume));
@@ -266,8 +354,6 @@ Rgb Gatherer::twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf
     if (next <= ks) break;
     ks = next;
   }
-  const uint32_t* idx = query_.index();
-  const float* d2 = query_.dist2();
   const uint16_t* dirs = s.directions();
   const uint32_t* energies = s.energies();
   // Compact the kept candidates without a branch (about half are kept, in
@@ -275,10 +361,11 @@ Rgb Gatherer::twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf
   int* kept = kept_.data();
   int m = 0;
   const unsigned lo8 = unsigned(win.lo), width8 = unsigned(win.hi - win.lo);
-  for (int i = 0; i < found; ++i) {
+  for (int i = 0; i < nc; ++i) {
     kept[m] = i;
     m += int(unsigned(bins[i]) - lo8 <= width8);
   }
+  lastSummed_ = m;
   // ---- slice correction ----
   // A photon of time t_p lies on the surface as it was at t_p. If the
   // surface moved along its normal, that copy is offset by
@@ -316,6 +403,7 @@ Rgb Gatherer::twoPassImpl(K1 k1, Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf
     report->volume = volume;
     report->windowLo = tq.binStart(win.lo);
     report->windowHi = tq.binStart(win.hi + 1);
+    report->summed = m;
   }
   return sum * (1.0f / volume);
 }
@@ -326,10 +414,11 @@ Rgb Gatherer::spaceTime4D(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf,
   const photon::PhotonStore& s = tree_->store();
   const photon::TimeQuantiser& tq = s.time();
   t = std::min(std::max(t, tq.t0), tq.t1);
+  lastSummed_ = 0;
   float maxD2 = opt_.maxRadius * opt_.maxRadius;
   const uint16_t* flags = s.flags();
   const double kappa = tree_->kappa();
-  int k = opt_.k, found = 0, qmin = 255, qmax = 0;
+  int k = opt_.k, found = 0;
   float D2 = 0.0f;
   double a = 0.0, b = 0.0, volume = 0.0;
   // At most twice, as the two-pass estimate: the k nearest, then (if their
@@ -342,19 +431,13 @@ Rgb Gatherer::spaceTime4D(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf,
       return Rgb(0.0f);
     }
     D2 = ballRadius2(found, k, maxD2);
-    const uint32_t* idx = query_.index();
-    qmin = 255;
-    qmax = 0;
-    for (int i = 0; i < found; ++i) {
-      int q = flags[idx[i]] & photon::kTimeMask;
-      qmin = std::min(qmin, q);
-      qmax = std::max(qmax, q);
-    }
-    // Time extent of the ellipsoid, clipped to the photons' bins (whose
-    // union lies inside the shutter): s in [a, b] relative to t.
+    // Time extent of the ellipsoid, clipped to the shutter: s in [a, b]
+    // relative to t. Not to the photons' own time range: that range is
+    // defined by the photons found, and dividing by it inflates the
+    // estimate where they are few (x2.8 on a sparse global map).
     double half = std::sqrt(double(D2) / kappa);
-    a = std::max(-half, double(tq.binStart(qmin)) - t);
-    b = std::min(half, double(tq.binStart(qmax + 1)) - t);
+    a = std::max(-half, double(tq.t0) - t);
+    b = std::min(half, double(tq.t1) - t);
     volume = clippedEllipsoidVolume(D2, kappa, a, b);
     if (attempt > 0 || !(volume < double(minVolume)) || !(volume > 0.0) || found < k) break;
     const int maxK = opt_.k * std::max(1, opt_.maxGrowth);
@@ -363,16 +446,20 @@ Rgb Gatherer::spaceTime4D(Vec3f x, Vec3f n, Vec3f wo, float t, const Brdf& brdf,
     if (next <= k) break;
     k = next;
   }
+  // The k-th photon closes the ellipsoid: (k-1) inside it (header).
+  const int first = boundaryFirst(found, k, maxD2);
+  lastSummed_ = found - first;
   if (report) {
     *report = Report{};
     report->candidates = found;
     report->kept = found;
+    report->summed = found - first;
   }
   const uint32_t* idx = query_.index();
   const uint16_t* dirs = s.directions();
   const uint32_t* energies = s.energies();
   Rgb sum(0.0f);
-  for (int i = 0; i < found; ++i) {
+  for (int i = first; i < found; ++i) {
     uint32_t p = idx[i];
     Vec3f wi = photon::decodeDirection(dirs[p]);
     if (!(dot(n, wi) > 0.0f)) continue;

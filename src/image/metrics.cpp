@@ -109,4 +109,34 @@ ImageMetrics compareImages(const ImageRgb& test, const ImageRgb& reference, cons
   return m;
 }
 
+namespace {
+inline double luminance(const Rgb& c) {
+  double v = 0.2126 * double(c.r) + 0.7152 * double(c.g) + 0.0722 * double(c.b);
+  return std::isfinite(v) ? v : 0.0;
+}
+// Median luminance of the 5x5 window around (x, y), clipped to the image.
+double median5x5(const ImageRgb& im, int x, int y) {
+  double v[25];
+  int n = 0;
+  for (int yy = std::max(0, y - 2); yy <= std::min(im.height - 1, y + 2); ++yy)
+    for (int xx = std::max(0, x - 2); xx <= std::min(im.width - 1, x + 2); ++xx) v[n++] = luminance(im.at(xx, yy));
+  std::nth_element(v, v + n / 2, v + n);
+  return v[n / 2];
+}
+}  // namespace
+
+SaltMetrics countSalt(const ImageRgb& test, const ImageRgb& reference, const PixelRect& region, double factor) {
+  TDPM_ASSERT(test.width == reference.width && test.height == reference.height, "countSalt: image sizes differ");
+  TDPM_ASSERT(cropInside(region, test.width, test.height), "countSalt: region outside the image");
+  SaltMetrics s;
+  for (int y = region.y; y < region.y + region.h; ++y)
+    for (int x = region.x; x < region.x + region.w; ++x) {
+      double v = luminance(test.at(x, y));
+      if (!(v > 0.0)) continue;
+      if (v > factor * median5x5(reference, x, y) && v > factor * median5x5(test, x, y)) ++s.count;
+    }
+  s.share = double(s.count) / (double(region.w) * double(region.h));
+  return s;
+}
+
 }  // namespace tdpm::image

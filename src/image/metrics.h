@@ -1,6 +1,7 @@
 // image/metrics.h — error metrics between a test image and a reference
 // image (what `tdpm compare` prints and the reproduction measures).
-// Owns: PixelRect, ChannelMetrics, ImageMetrics, compareImages, cropInside.
+// Owns: PixelRect, ChannelMetrics, ImageMetrics, compareImages, cropInside,
+// SaltMetrics / countSalt (isolated bright outliers, issue 24).
 // Pure functions over ImageRgb: no files, no printing.
 //
 // Definitions (v = test value, r = reference value, one pixel channel; every
@@ -67,5 +68,20 @@ NonFiniteValues findNonFinite(const ImageRgb& image, const PixelRect& region);
 // images always give the same bits.
 ImageMetrics compareImages(const ImageRgb& test, const ImageRgb& reference,
                            const std::optional<PixelRect>& region = std::nullopt);
+
+// Salt: test pixels whose luminance (Rec. 709 Y) is above `factor` times
+// both the reference's and the test's own median luminance over the 5x5
+// window around the pixel (the window clipped at the image's borders; the
+// neighbours may lie outside `region`, the pixels counted lie inside). A
+// k-NN estimate's rare huge values show as such isolated pixels; a real
+// bright feature is bright in the reference too, and a wide error is
+// bright in the test's own median. Share = count / pixels of the region.
+struct SaltMetrics {
+  size_t count = 0;
+  double share = 0;
+};
+constexpr double kSaltFactor = 3.0;
+SaltMetrics countSalt(const ImageRgb& test, const ImageRgb& reference, const PixelRect& region,
+                      double factor = kSaltFactor);
 
 }  // namespace tdpm::image

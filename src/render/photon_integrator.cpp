@@ -30,10 +30,29 @@ PhotonIntegrator::PhotonIntegrator(const Scene& scene, const PhotonMap* caustic,
 void PhotonIntegrator::flush(ThreadState& ts) const {
   standardCount_ += ts.counts.standard;
   timeCount_ += ts.counts.timeDependent;
+  causticCount_ += ts.counts.caustic;
+  globalCount_ += ts.counts.global;
+  fewCausticCount_ += ts.counts.fewCaustic;
+  fewGlobalCount_ += ts.counts.fewGlobal;
   ts.counts = {};
 }
 
-EstimateCounts PhotonIntegrator::counts() const { return {standardCount_.load(), timeCount_.load()}; }
+EstimateCounts PhotonIntegrator::counts() const {
+  return {standardCount_.load(), timeCount_.load(), causticCount_.load(), globalCount_.load(),
+          fewCausticCount_.load(), fewGlobalCount_.load()};
+}
+
+// Per-map k-NN estimate counts, and those from few photons (--stats).
+static void countEstimate(EstimateCounts& c, bool caustic, int summed) {
+  bool few = summed < estimate::kFewPhotons;
+  if (caustic) {
+    ++c.caustic;
+    c.fewCaustic += few;
+  } else {
+    ++c.global;
+    c.fewGlobal += few;
+  }
+}
 
 Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::Gatherer>& g,
                                std::unique_ptr<estimate::Gatherer>& g3, const Hit& hit, const ShadingContext& ctx,
@@ -66,7 +85,9 @@ Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::G
       g = std::make_unique<estimate::Gatherer>(map->tree, o);
     }
     float t = scene_.shutter.instant() ? map->store.t0() : scene_.shutter.fromNormalized(time01);
-    return g->radiance(hit.p, n, wo, t, brdf, nullptr, tag, minVolume);
+    Rgb L = g->radiance(hit.p, n, wo, t, brdf, nullptr, tag, minVolume);
+    countEstimate(counts, map == caustic_, g->lastSummed());
+    return L;
   }
   ++counts.standard;
   if (!g3) {
@@ -74,7 +95,9 @@ Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::G
     o.method = estimate::Method::Standard;
     g3 = std::make_unique<estimate::Gatherer>(map->spatialTree(), o);
   }
-  return g3->standard(hit.p, n, wo, brdf, nullptr, tag);
+  Rgb L = g3->standard(hit.p, n, wo, brdf, nullptr, tag);
+  countEstimate(counts, map == caustic_, g3->lastSummed());
+  return L;
 }
 
 template <class Stream>

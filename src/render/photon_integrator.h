@@ -47,6 +47,10 @@ struct PhotonIntegratorSettings {
 
 struct EstimateCounts {
   uint64_t standard = 0, timeDependent = 0;
+  // k-NN estimates per map, and those whose sum ran over fewer than
+  // estimate::kFewPhotons photons (--stats; issue 24). Counted per thread,
+  // summed at flush. The progressive fixed kernels are not counted here.
+  uint64_t caustic = 0, global = 0, fewCaustic = 0, fewGlobal = 0;
 };
 
 class PhotonIntegrator {
@@ -114,6 +118,7 @@ class PhotonIntegrator {
   const PhotonMap* global_;
   PhotonIntegratorSettings s_;
   mutable std::atomic<uint64_t> standardCount_{0}, timeCount_{0};
+  mutable std::atomic<uint64_t> causticCount_{0}, globalCount_{0}, fewCausticCount_{0}, fewGlobalCount_{0};
 };
 
 }  // namespace tdpm

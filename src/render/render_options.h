@@ -96,6 +96,9 @@ struct RenderStats {
   size_t guideCells = 0, guideCellsFilled = 0;  // its neighbour cache's sub-cells: all, and filled by the render
   double guideSeconds = 0;
   uint64_t standardEstimates = 0, timeEstimates = 0;
+  // k-NN estimates per map, and those from fewer than estimate::kFewPhotons
+  // photons (--stats; 0 for progressive passes, whose kernels are fixed).
+  uint64_t causticEstimates = 0, globalEstimates = 0, fewCausticEstimates = 0, fewGlobalEstimates = 0;
   int minSpp = 0, maxSpp = 0;  // over pixels
   uint64_t peakResidentBytes = 0;  // of the whole process, at the end of render() (core/memory.h)
   std::vector<std::string> warnings;  // for the user: empty photon maps and the like

@@ -411,6 +411,13 @@ PixelFilter pixelFilterFor(const RenderOptions& opt) {
 }
 
 namespace {
+// The per-map k-NN estimate counts of one integrator into the stats.
+void addMapCounts(RenderStats& st, const EstimateCounts& c) {
+  st.causticEstimates += c.caustic;
+  st.globalEstimates += c.global;
+  st.fewCausticEstimates += c.fewCaustic;
+  st.fewGlobalEstimates += c.fewGlobal;
+}
 
 // pathtrace: the caustic guide, then the adaptive passes.
 void renderPathTraced(const Scene& scene, const RenderOptions& opt, const SamplingPlan& plan, const Progress& progress,
@@ -444,6 +451,7 @@ void renderAccumulation(const Scene& scene, const RenderOptions& opt, const Samp
     renderPixels(scene, integ, framePlan, stage.c_str(), progress, one);
     EstimateCounts c = integ.counts();
     st.standardEstimates += c.standard;
+    addMapCounts(st, c);
     for (size_t i = 0; i < sum.color.size(); ++i) {
       sum.color[i] += one.color[i];
       sum.sampleCount[i] += one.sampleCount[i];
@@ -472,6 +480,7 @@ void renderPhotonMapped(const Scene& scene, const RenderOptions& opt, const Samp
   EstimateCounts c = integ.counts();
   st.standardEstimates = c.standard;
   st.timeEstimates = c.timeDependent;
+  addMapCounts(st, c);
 }
 
 // Distributed: rank 0 gathers the film from the tiles' owners; estimate
@@ -482,10 +491,15 @@ void gatherFilm(dist::Comm& comm, TileOwners& owners, RenderStats& st, Film& fil
   sharePixels(comm, film.width, film.height, film.color, false, owners);
   sharePixels(comm, film.width, film.height, film.sampleCount, false, owners);
   sharePixels(comm, film.width, film.height, film.varianceOfMean, false, owners);
-  uint64_t counts[2] = {st.standardEstimates, st.timeEstimates};
-  comm.allreduceSum(counts, 2);
+  uint64_t counts[6] = {st.standardEstimates, st.timeEstimates, st.causticEstimates,
+                        st.globalEstimates, st.fewCausticEstimates, st.fewGlobalEstimates};
+  comm.allreduceSum(counts, 6);
   st.standardEstimates = counts[0];
   st.timeEstimates = counts[1];
+  st.causticEstimates = counts[2];
+  st.globalEstimates = counts[3];
+  st.fewCausticEstimates = counts[4];
+  st.fewGlobalEstimates = counts[5];
 }
 
 }  // namespace
@@ -549,6 +563,7 @@ Film renderFrame(const Scene& scene, const RenderOptions& opt, const FrameInput&
     EstimateCounts c = integ.counts();
     st.standardEstimates = c.standard;
     st.timeEstimates = c.timeDependent;
+    addMapCounts(st, c);
   }
   finishStats(film, st);
   st.seconds = timer.seconds();
