@@ -601,7 +601,10 @@ void Importer::finish(const std::string& file) {
     failAt(stack_.back().at, std::string(stack_.back().attribute ? "AttributeBegin" : "TransformBegin") + " without a matching End");
   if (imagingRatio_ != 1) {
     float k = float(imagingRatio_);
-    for (auto& l : result.scene.lights) l.power = l.power * k;
+    for (auto& l : result.scene.lights) {
+      if (l.type == scene::LightDesc::Type::Environment) l.radiance = l.radiance * k;
+      else l.power = l.power * k;
+    }
     result.scene.background = result.scene.background * k;
     result.notes.push_back(film_.at.str() + ": Film: pbrt-v4 scales the image by exposure time x ISO / 100 = " +
                            fmtNum(imagingRatio_) + "; the import scales every light by it");

@@ -30,4 +30,19 @@ inline float emissionWeight(float bsdfPdf, float lightPdf, int bsdfSamples) {
   return b * b / (b * b + lightPdf * lightPdf);
 }
 
+// What a ray escaping along `dir` finds of the environment lights: each
+// one's radiance, weighted against its own light sampling by the same
+// heuristic (fullWeight: a camera or delta-sampled ray, which light
+// sampling could not have made). Zero without environment lights.
+inline Rgb environmentEmission(const Scene& scene, Vec3f dir, float bsdfPdf, int bsdfSamples, bool fullWeight) {
+  Rgb sum(0.0f);
+  for (uint32_t i : scene.environmentLights) {
+    const Light& light = scene.lights[i];
+    Rgb le = environmentRadiance(light, dir);
+    if (le.isBlack()) continue;
+    sum += le * (fullWeight ? 1.0f : emissionWeight(bsdfPdf, environmentPdf(light, dir), bsdfSamples));
+  }
+  return sum;
+}
+
 }  // namespace tdpm
