@@ -102,7 +102,7 @@ size_t EnvironmentMap::texelIndex(Vec3f local, float* sinTheta) const {
   Vec2f uv = latLongUv(local);
   int x = std::clamp(int(uv.x * width_), 0, width_ - 1);
   int y = std::clamp(int(uv.y * height_), 0, height_ - 1);
-  *sinTheta = std::sqrt(std::max(0.0f, 1.0f - local.z * local.z));
+  *sinTheta = std::sqrt(local.x * local.x + local.y * local.y);  // accurate near the poles, unlike 1 - z^2
   return size_t(y) * size_t(width_) + size_t(x);
 }
 
