@@ -298,6 +298,8 @@ TEST_CASE("environment: bad maps and parameters are located errors") {
   CHECK(errorOf(R"({"type": "environment", "L": [1, -1, 1]})").find("lights[0].L") != std::string::npos);
   CHECK(errorOf(R"({"type": "environment", "scale": -2})").find("lights[0].scale") != std::string::npos);
   CHECK(errorOf(R"({"type": "environment", "motion": []})").find("does not move") != std::string::npos);
+  CHECK(errorOf(R"({"type": "environment", "transform": {"scale": [1, 2, 1]}})").find("lights[0].transform.scale") !=
+        std::string::npos);
   // A file of no texels: readers refuse it, and the message names it.
   std::string empty = (tempDir() / "empty.pfm").string();
   { std::ofstream(empty) << "PF\n0 0\n-1.0\n"; }

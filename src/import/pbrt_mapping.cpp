@@ -344,6 +344,12 @@ void Importer::environmentLight(const ParamSet& ps, const Mat& M, const Loc& at)
   ps.checkAllUsed();
   std::optional<Pose> pose = decompose(M);
   if (!pose) failAt(at, what + ": the light's transform has shear (not a rotation and scale)");
+  Vec3f a{std::fabs(pose->scale.x), std::fabs(pose->scale.y), std::fabs(pose->scale.z)};
+  if (std::fabs(a.x - a.y) > 1e-5f * a.x || std::fabs(a.y - a.z) > 1e-5f * a.y)
+    failAt(at, what + ": the light's transform has a non-uniform scale, which would distort the map (pbrt does not "
+                      "correct its densities for it); not supported");
+  // Only the rotation and mirror matter: write unit scales (exactly uniform).
+  pose->scale = {std::copysign(1.0f, pose->scale.x), std::copysign(1.0f, pose->scale.y), std::copysign(1.0f, pose->scale.z)};
   l.placement.rotate = canonicalRotation(pose->rotate);
   l.placement.scale = pose->scale;
   l.radiance = L;

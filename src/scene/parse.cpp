@@ -604,6 +604,13 @@ void checkLightPlacement(const Node& n, const LightDesc& l, Shutter s) {
   if (l.type == LightDesc::Type::Directional) return;  // a direction only
   if (l.type == LightDesc::Type::Environment) {        // a rotation (or mirror) only
     checkScales(n, l.placement, l.motion);
+    // A stretch would make sampling densities in the light's frame wrong in
+    // the world's (pbrt ignores that Jacobian); a uniform scale changes nothing.
+    Vec3f a{std::fabs(l.placement.scale.x), std::fabs(l.placement.scale.y), std::fabs(l.placement.scale.z)};
+    if (a.x != a.y || a.y != a.z)
+      memberOr(memberOr(n, "transform"), "scale")
+          .fail("an environment light's transform may rotate and mirror it, not stretch it: scale " +
+                formatVec(l.placement.scale) + " is not uniform in magnitude");
     return;
   }
   checkScales(n, l.placement, l.motion);
