@@ -22,6 +22,7 @@
 #include "error_capture.h"
 #include "image/pfm.h"
 #include "import/pbrt_import.h"
+#include "render/fingerprint.h"
 #include "render/renderer.h"
 #include "scene/environment.h"
 #include "scene/json_writer.h"
@@ -386,4 +387,15 @@ Rotate -90 1 0 0
       same = a.color[i].r == b.color[i].r && a.color[i].g == b.color[i].g && a.color[i].b == b.color[i].b;
     CHECK(same);
   }
+}
+
+TEST_CASE("environment: the resume fingerprint holds the map's texels, not its path") {
+  image::ImageRgb a(4, 2, Rgb(0.5f)), b = a;
+  b.at(3, 1) = Rgb(0.5f, 0.5f, 0.6f);
+  auto digestOf = [](const std::string& file) {
+    return sceneDigest(parseText(sphereScene(0.5f, R"({"type": "environment", "filename": ")" + file + R"("})")));
+  };
+  std::string da = digestOf(writeMap("fa.pfm", a));
+  CHECK(digestOf(writeMap("fa-copy.pfm", a)) == da);  // a copy elsewhere resumes
+  CHECK(digestOf(writeMap("fa.pfm", b)) != da);       // one texel changed does not
 }
