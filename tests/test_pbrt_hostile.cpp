@@ -382,9 +382,11 @@ TEST_CASE("pbrt-v3 Film \"image\" \"float scale\" scales every light (linear tra
   std::string world = "WorldBegin\nLightSource \"point\" \"rgb I\" [1 2 3]\nLightSource \"infinite\" \"rgb L\" [0.5 0.5 0.5]\n";
   pbrt::ImportResult one = pbrt::importPbrtText("Film \"image\"\n" + world, "dir/q.pbrt");
   pbrt::ImportResult four = pbrt::importPbrtText("Film \"image\" \"float scale\" 4\n" + world, "dir/q.pbrt");
-  REQUIRE(four.scene.lights.size() == 1);
+  // The point light and the infinite light (an environment light): power and radiance both x4.
+  REQUIRE(four.scene.lights.size() == 2);
   CHECK(four.scene.lights[0].power.g == 4 * one.scene.lights[0].power.g);
-  CHECK(four.scene.background.r == 2.0f);
+  CHECK(four.scene.lights[1].type == scene::LightDesc::Type::Environment);
+  CHECK(four.scene.lights[1].radiance.r == 2.0f);
   CHECK(hasNote(four, "dir/q.pbrt:1: Film: pbrt-v3's Film \"image\" scales the image by \"scale\" = 4; the import scales every light by it"));
   CHECK(contains(errorOf("Film \"image\" \"float scale\" 0\nWorldBegin\n"), "dir/q.pbrt:1: Film \"image\": parameter \"float scale\": must be positive"));
 }

@@ -242,16 +242,18 @@ TEST_CASE("pbrt camera and sphere: the same description and image as the equival
     "camera": {"position": [0, 0, 0], "target": [0, 0, 1], "up": [0, 1, 0], "fov": 50, "resolution": [24, 16]},
     "materials": {"m": {"type": "diffuse", "color": [0.7, 0.2, 0.2]}},
     "objects": [{"shape": {"type": "sphere", "radius": 0.5}, "material": "m", "transform": {"translate": [-0.8, 0.3, 4]}}],
-    "lights": [{"type": "point", "position": [-1, 2, 1], "power": )") + num9(power) + R"(}],
-    "background": [0.1, 0.1, 0.1],
+    "lights": [{"type": "point", "position": [-1, 2, 1], "power": )") + num9(power) + R"(},
+               {"type": "environment", "L": [0.1, 0.1, 0.1], "transform": {"scale": [-1, 1, 1]}}],
     "render": {"method": "pathtrace", "spp": 4, "max_depth": 5}})";
   scene::SceneDescription j = scene::parseScene(json, "equivalent.json");
   CHECK(d.camera.fovDegrees == 50.0f);
   CHECK(d.render.spp == 4);
   CHECK(d.render.maxDepth == 5);
   CHECK(*d.render.method == "pathtrace");
-  REQUIRE(d.lights.size() == 1);
+  REQUIRE(d.lights.size() == 2);
   CHECK(d.lights[0].power.r == j.lights[0].power.r);
+  CHECK(d.lights[1].type == scene::LightDesc::Type::Environment);
+  CHECK(d.lights[1].placement.scale.x == -1.0f);  // the import's mirror
   Film a = renderDesc(d), b = renderDesc(j);
   CHECK(sum(a) > 0);
   CHECK(sameImage(a, b));
@@ -367,7 +369,7 @@ Shape "sphere"
   CHECK(cam.camera.motion[1].position.x == doctest::Approx(-1.0f));  // camera at pbrt +1, mirrored
 }
 
-TEST_CASE("pbrt lights: intensities, radiances, v4 scale/power and the infinite background map exactly") {
+TEST_CASE("pbrt lights: intensities, radiances, v4 scale/power and the infinite light map exactly") {
   const double pi = 3.14159265358979323846;
   scene::SceneDescription d = importText(R"(
 Scale -1 1 1
@@ -385,7 +387,7 @@ AttributeBegin
   Shape "trianglemesh" "point3 P" [-1 -0.5 0  1 -0.5 0  1 0.5 0  -1 0.5 0] "integer indices" [0 1 2 0 2 3]
 AttributeEnd
 )");
-  REQUIRE(d.lights.size() == 5);
+  REQUIRE(d.lights.size() == 6);
   CHECK(d.lights[0].power.g == doctest::Approx(2 * 2 * 4 * pi));  // I * scale * 4 pi
   CHECK(d.lights[0].position.y == 1.0f);
   CHECK(d.lights[1].power.r == doctest::Approx(100.0));  // v4 power: the total, whatever I is
@@ -396,8 +398,10 @@ AttributeEnd
   CHECK(d.lights[3].type == scene::LightDesc::Type::Directional);
   CHECK(d.lights[3].direction.y == doctest::Approx(-1.0f));  // travels from "from" to "to"
   CHECK(d.lights[3].power.r == 0.5f);
-  CHECK(d.background.b == 0.4f);
-  const auto& area = d.lights[4];
+  CHECK(d.lights[4].type == scene::LightDesc::Type::Environment);  // pbrt's infinite light
+  CHECK(d.lights[4].radiance.b == 0.4f);
+  CHECK(d.lights[4].mapFile.empty());
+  const auto& area = d.lights[5];
   CHECK(area.type == scene::LightDesc::Type::Area);
   CHECK(area.areaSize.x == doctest::Approx(2.0f));
   CHECK(area.areaSize.y == doctest::Approx(1.0f));
@@ -573,7 +577,8 @@ TEST_CASE("pbrt errors name file:line and the statement or parameter") {
       {"WorldBegin\nMaterial \"matte\" \"spectrum Kd\" [400 0.5 700 0.5]\n", "spectral values are not supported"},
       {"WorldBegin\nMaterial \"glass\" \"rgb Kr\" [1 1 1] \"rgb Kt\" [0.5 0.5 0.5]\n", "dir/t.pbrt:2: glass: Kr and Kt differ"},
       {"WorldBegin\nLightSource \"goniometric\"\n", "dir/t.pbrt:2: LightSource \"goniometric\" is not supported"},
-      {"WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.exr\"\n", "dir/t.pbrt:2: LightSource \"infinite\": an environment map"},
+      {"WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.exr\"\n", "dir/t.pbrt:2: LightSource \"infinite\": dir/sky.exr: "},
+      {"WorldBegin\nLightSource \"infinite\" \"float power\" 3\n", "dir/t.pbrt:2: LightSource \"infinite\": \"power\" is not supported"},
       {"WorldBegin\nAreaLightSource \"diffuse\" \"bool twosided\" true\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 1 1 0 0 1 0] \"integer indices\" [0 1 2 0 2 3]\n",
        "dir/t.pbrt:2: AreaLightSource: twosided"},
       {"WorldBegin\nAreaLightSource \"diffuse\"\nShape \"sphere\"\n", "dir/t.pbrt:3: Shape \"sphere\" with an AreaLightSource"},

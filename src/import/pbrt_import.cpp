@@ -759,16 +759,19 @@ void Importer::finish(const std::string& file) {
   if (imagingRatio_ != 1) {
     float k = float(imagingRatio_);
     for (auto& l : result.scene.lights) {
-      l.power = l.power * k;
-      if (!std::isfinite(l.power.r) || !std::isfinite(l.power.g) || !std::isfinite(l.power.b))
+      if (l.type == scene::LightDesc::Type::Environment) l.radiance = l.radiance * k;
+      else l.power = l.power * k;
+      const Rgb& v = l.type == scene::LightDesc::Type::Environment ? l.radiance : l.power;
+      if (!std::isfinite(v.r) || !std::isfinite(v.g) || !std::isfinite(v.b))
         failAt(film_.at, "Film: " + filmFactorWhat_ + " = " + fmtNum(imagingRatio_) + ", which makes " +
-                             l.name + " infinitely bright (its power overflows a float)");
+                             l.name + " infinitely bright (its " +
+                             (l.type == scene::LightDesc::Type::Environment ? "radiance" : "power") + " overflows a float)");
     }
     if (!result.scene.background.isBlack()) result.scene.background = result.scene.background * k;
     if (!std::isfinite(result.scene.background.r) || !std::isfinite(result.scene.background.g) ||
         !std::isfinite(result.scene.background.b))
       failAt(film_.at, "Film: " + filmFactorWhat_ + " = " + fmtNum(imagingRatio_) +
-                           ", which makes the infinite light's radiance overflow a float");
+                           ", which makes the background radiance overflow a float");
     result.notes.push_back(film_.at.str() + ": Film: " + filmFactorWhat_ + " = " + fmtNum(imagingRatio_) +
                            "; the import scales every light by it");
   }

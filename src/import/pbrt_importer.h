@@ -115,6 +115,7 @@ class Importer {
   void worldBegin(const Loc& at);
   void shape(const std::string& type, ParamSet params, const Loc& at);
   void lightSource(const std::string& type, const ParamSet& ps, const Loc& at);
+  void environmentLight(const ParamSet& ps, const Mat& M, const Loc& at);
   void texture(const std::string& name, const std::string& kind, const std::string& type, const ParamSet& ps, const Loc& at);
   MaterialSlot makeMaterial(const std::string& type, const ParamSet& ps, const Loc& at, const std::string& name);
 

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "import/pbrt_importer.h"
 #include "import/ply_reader.h"
+#include "scene/environment.h"
 #include "scene/json_writer.h"
 
 namespace tdpm::pbrt::detail {
@@ -310,12 +311,7 @@ void Importer::lightSource(const std::string& type, const ParamSet& ps, const Lo
     l.direction = canonicalDirection(normalize(dir));  // pbrt's light travels from "from" toward "to"
     l.power = L;                   // irradiance on a surface facing the light
   } else if (type == "infinite") {
-    if (ps.has("filename") || ps.has("mapname")) failAt(at, "LightSource \"infinite\": an environment map is not supported (constant L only)");
-    if (power > 0 || ps.has("illuminance")) failAt(at, "LightSource \"infinite\": \"power\"/\"illuminance\" is not supported; give L");
-    Rgb L = nonNegative(ps, "L", color(ps, "L", Rgb(1.0f))) * sc;
-    ps.checkAllUsed();
-    result.scene.background = result.scene.background + L;
-    backgroundAt_ = at;
+    environmentLight(ps, M, at);
     return;
   } else {
     failAt(at, "LightSource \"" + type + "\" is not supported (point, spot, distant, infinite)");
@@ -323,6 +319,55 @@ void Importer::lightSource(const std::string& type, const ParamSet& ps, const Lo
   ps.checkAllUsed();
   result.scene.lights.push_back(l);
   lightAt_.push_back(at);
+}
+
+// pbrt's "infinite" light: constant L, a pbrt-v3 lat-long "mapname", or a
+// pbrt-v4 equal-area square "filename"; pbrt-v4's "illuminance" scales it so
+// that the upper hemisphere (light-space +z) gives that illuminance on a
+// surface facing +z. Translation is ignored, as pbrt does.
+void Importer::environmentLight(const ParamSet& ps, const Mat& M, const Loc& at) {
+  const std::string what = "LightSource \"infinite\"";
+  if (ps.has("power")) failAt(at, what + ": \"power\" is not supported; give L, scale or illuminance");
+  if (ps.has("portal")) failAt(at, what + ": \"portal\" is not supported (it only changes pbrt's sampling; remove it)");
+  if (ps.has("filename") && ps.has("mapname")) failAt(at, what + ": give \"filename\" or \"mapname\", not both");
+  scene::LightDesc l;
+  l.type = scene::LightDesc::Type::Environment;
+  l.name = "LightSource \"infinite\" (" + at.str() + ")";
+  Rgb L = nonNegative(ps, "L", color(ps, "L", Rgb(1.0f))) * lightScale(ps);
+  for (const char* key : {"filename", "mapname"}) {
+    if (!ps.has(key)) continue;
+    std::string file = ps.getString(key, "");
+    if (file.empty()) failAt(at, what + ": \"" + key + "\" is empty");
+    l.mapFile = resolvePath(file, at.file, mainDir);
+    l.equalArea = std::string(key) == "filename";  // pbrt-v4 names it filename and wants it equal-area
+    std::string problem;
+    l.map = loadEnvironmentMap(l.mapFile, l.equalArea, &problem);
+    if (!l.map) failAt(at, what + ": " + problem);
+  }
+  double illuminance = ps.has("illuminance") ? ps.getFloat("illuminance", -1) : -1;
+  if (ps.has("illuminance") && !(illuminance > 0 && std::isfinite(illuminance)))
+    failAt(at, what + ": \"illuminance\" must be positive, got " + fmtNum(illuminance));
+  if (illuminance > 0) {
+    // pbrt-v4 k_e: pi for a constant (its spectrum's own luminance normalised
+    // away, as for RGB in pbrt-v4), the map's hemisphere integral otherwise.
+    double ke = l.map ? upperHemisphereIlluminance(*l.map) : kPiD;
+    if (!(ke > 0)) failAt(at, what + ": \"illuminance\" with a map that is black over its upper hemisphere");
+    L = L * float(illuminance / ke);
+  }
+  for (const char* q : {"nsamples", "samples"}) ps.markUsed(q);
+  ps.checkAllUsed();
+  std::optional<Pose> pose = decompose(M);
+  if (!pose) failAt(at, what + ": the light's transform has shear (not a rotation and scale)");
+  Vec3f a{std::fabs(pose->scale.x), std::fabs(pose->scale.y), std::fabs(pose->scale.z)};
+  if (std::fabs(a.x - a.y) > 1e-5f * a.x || std::fabs(a.y - a.z) > 1e-5f * a.y)
+    failAt(at, what + ": the light's transform has a non-uniform scale, which would distort the map (pbrt does not "
+                      "correct its densities for it); not supported");
+  // Only the rotation and mirror matter: write unit scales (exactly uniform).
+  pose->scale = {std::copysign(1.0f, pose->scale.x), std::copysign(1.0f, pose->scale.y), std::copysign(1.0f, pose->scale.z)};
+  l.placement.rotate = canonicalRotation(pose->rotate);
+  l.placement.scale = pose->scale;
+  l.radiance = L;
+  result.scene.lights.push_back(l);
 }
 
 // ------------------------------------------------------------ shapes

@@ -194,6 +194,36 @@ float sampleTowardTargets(const std::vector<Target>& targets, Vec3f x, const Emi
   return float(std::max(covering, 1)) / total;
 }
 
+// The sun's emission disc (travel direction d, irradiance e), restricted to
+// the targets' shadows on it; an environment light's after its direction.
+bool discTowardTargets(Vec3f d, Rgb e, const std::vector<Target>& targets, const Bounds3f& bounds, Vec3f uvw,
+                       EmittedRay& out) {
+  Vec3f c = bounds.empty() ? Vec3f(0, 0, 0) : bounds.center();
+  float R = bounds.empty() ? 1.0f : 0.5f * length(bounds.diagonal()) * 1.001f + 1e-6f;
+  float total = 0;
+  for (const Target& t : targets) total += kPi * t.radius * t.radius;
+  if (!(total > 0)) return false;
+  float pick = uvw.x * total, acc = 0;
+  size_t j = 0;
+  for (; j + 1 < targets.size(); ++j) {
+    acc += kPi * targets[j].radius * targets[j].radius;
+    if (pick < acc) break;
+  }
+  Frame f(d);
+  Vec2f disk = squareToConcentricDisk({uvw.y, uvw.z});
+  Vec3f onPlane = targets[j].centre - d * dot(d, targets[j].centre - c) +
+                  (f.s * disk.x + f.t * disk.y) * targets[j].radius;
+  int covering = 0;
+  for (const Target& t : targets) {
+    Vec3f tc = t.centre - d * dot(d, t.centre - c);
+    covering += lengthSquared(onPlane - tc) <= t.radius * t.radius;
+  }
+  out.origin = onPlane - d * (R + std::fabs(dot(d, onPlane - c)));
+  out.direction = d;
+  out.flux = e * (total / float(std::max(covering, 1)));
+  return true;
+}
+
 // Caustic-map emission of one light toward the targets. flux = emitted
 // radiometric quantity / density, as in emitFromLight.
 template <class Stream>
@@ -234,33 +264,17 @@ bool emitTowardTargets(const Light& light, const std::vector<Target>& targets, f
       return true;
     }
     case Light::Type::Directional: {
-      // The sun's emission disc, restricted to the targets' shadows on it.
       Affine3f m = light.motion.atNormalized(time01);
-      Vec3f d = normalize(m.vector(light.direction));
-      Vec3f c = bounds.empty() ? Vec3f(0, 0, 0) : bounds.center();
-      float R = bounds.empty() ? 1.0f : 0.5f * length(bounds.diagonal()) * 1.001f + 1e-6f;
-      float total = 0;
-      for (const Target& t : targets) total += kPi * t.radius * t.radius;
-      if (!(total > 0)) return false;
-      float pick = uvw.x * total, acc = 0;
-      size_t j = 0;
-      for (; j + 1 < targets.size(); ++j) {
-        acc += kPi * targets[j].radius * targets[j].radius;
-        if (pick < acc) break;
-      }
-      Frame f(d);
-      Vec2f disk = squareToConcentricDisk({uvw.y, uvw.z});
-      Vec3f onPlane = targets[j].centre - d * dot(d, targets[j].centre - c) +
-                      (f.s * disk.x + f.t * disk.y) * targets[j].radius;
-      int covering = 0;
-      for (const Target& t : targets) {
-        Vec3f tc = t.centre - d * dot(d, t.centre - c);
-        covering += lengthSquared(onPlane - tc) <= t.radius * t.radius;
-      }
-      out.origin = onPlane - d * (R + std::fabs(dot(d, onPlane - c)));
-      out.direction = d;
-      out.flux = light.power * (total / float(std::max(covering, 1)));
-      return true;
+      return discTowardTargets(normalize(m.vector(light.direction)), light.power, targets, bounds, uvw, out);
+    }
+    case Light::Type::Environment: {
+      // A sky direction by luminance, then the sun's disc toward the targets
+      // with irradiance L / pdf (its expectation is the integral of L).
+      Vec3f w;
+      Rgb L;
+      float pdf;
+      if (!light.env->sample(rng.get2D(dims::kPhotonPosition), w, L, pdf)) return false;
+      return discTowardTargets(-w, L / pdf, targets, bounds, uvw, out);
     }
   }
   return false;
@@ -296,6 +310,7 @@ double powerTowardTargets(const Light& light, const std::vector<Target>& targets
       return (light.power / (kPi * fr.area)).average() * fr.area * std::min(sum, double(kPi));
     }
     case Light::Type::Directional:
+    case Light::Type::Environment:  // power: the integral of its radiance (see emittedPower)
       for (const Target& t : targets) sum += kPi * double(t.radius) * t.radius;
       return light.power.average() * sum;
   }
@@ -311,7 +326,10 @@ LightTable makeLightTable(const Scene& scene, const std::vector<Target>* targets
   for (const Light& l : scene.lights) {
     double p = targets ? powerTowardTargets(l, *targets) : std::max(0.0f, emittedPower(l, scene.bounds).average());
     p = std::max(0.0, p);
-    if (areaLightsOnly && l.isDelta()) p = 0.0;
+    // The caustic guide serves area lights: an environment's photons made it
+    // slower and noisier on caustic-glass (0.83 s / relMSE 0.00232 against
+    // 0.55 s / 0.00177 without, 105x150 at 32 spp).
+    if (areaLightsOnly && l.type != Light::Type::Area) p = 0.0;
     w.push_back(p);
     total += p;
   }

@@ -13,6 +13,7 @@ Rgb directLight(const Scene& scene, const Hit& hit, const ShadingContext& ctx, f
   Rgb sum(0.0f);
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     const Light& light = scene.lights[i];
+    if (bsdfSamples > 0 && bsdfAlone(light)) continue;  // the caller's BSDF rays carry it at full weight
     LightSample ls;
     Vec2f u = sampler.get2D(dims::vertexGroup(vertex, dims::kLightPosition, uint32_t(i)));
     if (!sampleLight(light, hit.p, time01, u, ls)) continue;

@@ -30,4 +30,29 @@ inline float emissionWeight(float bsdfPdf, float lightPdf, int bsdfSamples) {
   return b * b / (b * b + lightPdf * lightPdf);
 }
 
+// A constant environment is left to BSDF sampling when there is any (as
+// pbrt-v4 does: its uniform sphere samples are no better than cosine-weighted
+// BSDF rays, and on caustic-glass at 32 spp they cost 12% more time for 6%
+// more relMSE); directLight samples it only with bsdfSamples = 0.
+inline bool bsdfAlone(const Light& light) {
+  return light.type == Light::Type::Environment && light.env->isConstant();
+}
+
+// What a ray escaping along `dir` finds of the environment lights: each
+// one's radiance, weighted against its own light sampling by the same
+// heuristic (fullWeight: a camera or delta-sampled ray, which light
+// sampling could not have made). Zero without environment lights.
+// bsdfSamples >= 1 (the escaping ray is one of them).
+inline Rgb environmentEmission(const Scene& scene, Vec3f dir, float bsdfPdf, int bsdfSamples, bool fullWeight) {
+  Rgb sum(0.0f);
+  for (uint32_t i : scene.environmentLights) {
+    const Light& light = scene.lights[i];
+    Rgb le = environmentRadiance(light, dir);
+    if (le.isBlack()) continue;
+    bool full = fullWeight || bsdfAlone(light);
+    sum += le * (full ? 1.0f : emissionWeight(bsdfPdf, environmentPdf(light, dir), bsdfSamples));
+  }
+  return sum;
+}
+
 }  // namespace tdpm

@@ -127,6 +127,16 @@ std::string sceneDigest(const scene::SceneDescription& d) {
     s.indices.clear();
     s.meshFile.clear();
   }
+  for (scene::LightDesc& l : c.lights) {
+    if (!l.map) continue;
+    // An environment map by its (lat-long) texels, like a mesh by its triangles.
+    h.add("environment " + l.name);
+    int64_t size[2] = {l.map->width, l.map->height};
+    h.add(size, sizeof size);
+    h.add(l.map->pixels.data(), l.map->pixels.size() * sizeof(Rgb));
+    l.map.reset();
+    l.mapFile.clear();
+  }
   h.add(pbrt::sceneToJson(c, "scene.json").json);
   return h.hex();
 }

@@ -51,6 +51,7 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
     Hit hit;
     if (!scene_.intersect(origin, dir, std::numeric_limits<float>::infinity(), time01, hit)) {
       L += beta * scene_.background;
+      if (!scene_.environmentLights.empty()) L += beta * environmentEmission(scene_, dir, lastPdf, 1, lastDelta);
       break;
     }
     // ---- emission: a BSDF-sampled ray that hits an area light ----

@@ -115,6 +115,9 @@ Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, flo
       Hit h;
       if (!scene_.intersect(o, d, kInf, time01, h)) {
         sum += beta * scene_.background;
+        // As an area light below: straight from the gather point only.
+        if (bounce == 0 && !scene_.environmentLights.empty())
+          sum += beta * environmentEmission(scene_, d, bs.pdf, s_.gatherRays, false);
         break;
       }
       moved = moved || scene_.segmentMeetsMotion(o, d, h.t);
@@ -221,6 +224,9 @@ Rgb PhotonIntegrator::traceFrom(Vec3f origin, Vec3f dir, float time01, EyeVertex
     Hit hit;
     if (!scene_.intersect(origin, dir, kInf, time01, hit)) {
       addEye(beta * scene_.background);
+      // The environment as an area light hit below.
+      if (emissionCounts && !scene_.environmentLights.empty())
+        addEye(beta * environmentEmission(scene_, dir, metalPdf, 1, !(metalPdf > 0.0f)));
       break;
     }
     pathLength += hit.t;

@@ -92,6 +92,7 @@ Light toLight(const scene::LightDesc& d, const Shutter& shutter) {
     case scene::LightDesc::Type::Spot: l.type = Light::Type::Spot; break;
     case scene::LightDesc::Type::Directional: l.type = Light::Type::Directional; break;
     case scene::LightDesc::Type::Area: l.type = Light::Type::Area; break;
+    case scene::LightDesc::Type::Environment: l.type = Light::Type::Environment; break;
   }
   l.power = d.power;
   l.position = d.position;
@@ -100,6 +101,12 @@ Light toLight(const scene::LightDesc& d, const Shutter& shutter) {
   l.cosFalloffStart = std::cos(d.falloffStart * kPi / 180.0f);
   l.size = d.areaSize;
   l.motion = makeMotion(d.placement, d.motion, shutter);
+  if (l.type == Light::Type::Environment) {
+    Affine3f toWorld = d.placement.matrix();
+    Rgb k = d.radiance * d.scale;
+    l.env = std::make_shared<const EnvironmentMap>(d.map ? EnvironmentMap::fromLatLong(*d.map, k, toWorld)
+                                                         : EnvironmentMap::constant(k, toWorld));
+  }
   finalizeLight(l);
   return l;
 }
@@ -182,6 +189,8 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
       Bounds3f swept = l.motion.sweptBounds(local);
       s.bounds.extend(swept);
       if (l.motion.moving()) s.movingBounds.push_back(swept);
+    } else if (l.type == Light::Type::Environment) {
+      s.environmentLights.push_back(uint32_t(s.lights.size()));  // at infinity: no bounds
     } else if (l.type != Light::Type::Directional) {
       for (int i = 0; i < l.motion.stepCount(); ++i) s.bounds.extend(l.motion.step(i).point(l.position));
     }

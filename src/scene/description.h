@@ -6,10 +6,12 @@
 #pragma once
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "image/image.h"
 #include "math/transform.h"
 #include "math/vec.h"
 
@@ -74,7 +76,7 @@ struct ObjectDesc {
 };
 
 struct LightDesc {
-  enum class Type { Point, Spot, Directional, Area };
+  enum class Type { Point, Spot, Directional, Area, Environment };
   Type type = Type::Point;
   std::string name;
   // Point, spot, area: total emitted power (W) per channel.
@@ -86,8 +88,17 @@ struct LightDesc {
   float coneAngle = 30.0f;     // spot: total half-angle (degrees), (0, 90]
   float falloffStart = 25.0f;  // spot: half-angle where falloff begins, <= coneAngle
   Vec2f areaSize{1, 1};        // area: rectangle in the local x-z plane, emits toward local -y
-  TransformDesc placement;     // area: its placement; others: identity unless given
-  MotionDesc motion;           // any light may move
+  TransformDesc placement;     // area: its placement; environment: light-to-world
+                               // (translation ignored); others: identity unless given
+  MotionDesc motion;           // any light but an environment may move
+  // Environment: radiance = scale x radiance x the map's texel (1 without a map).
+  Rgb radiance{1, 1, 1};
+  float scale = 1.0f;
+  std::string mapFile;         // as resolved against the scene's directory; empty: constant
+  bool equalArea = false;      // mapFile is pbrt-v4's square equal-area map (else lat-long)
+  // The map's texels as lat-long (converted when equalArea), read and
+  // checked by the parser (or the pbrt importer).
+  std::shared_ptr<const image::ImageRgb> map;
 };
 
 struct CameraKeyframe {

@@ -120,6 +120,7 @@ const char* lightType(scene::LightDesc::Type t) {
     case scene::LightDesc::Type::Spot: return "spot";
     case scene::LightDesc::Type::Directional: return "directional";
     case scene::LightDesc::Type::Area: return "area";
+    case scene::LightDesc::Type::Environment: return "environment";
   }
   return "point";
 }
@@ -232,6 +233,18 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
       case scene::LightDesc::Type::Area:
         j["size"] = Json::array({num(l.areaSize.x), num(l.areaSize.y)});
         j["power"] = rgb(l.power);
+        break;
+      case scene::LightDesc::Type::Environment:
+        j["L"] = rgb(l.radiance);
+        j["scale"] = num(l.scale);
+        if (!l.mapFile.empty()) {
+          // Relative to the written JSON when both paths allow it.
+          std::filesystem::path map = std::filesystem::absolute(l.mapFile).lexically_normal();
+          std::filesystem::path dir = std::filesystem::absolute(jp).lexically_normal().parent_path();
+          std::filesystem::path rel = map.lexically_relative(dir);
+          j["filename"] = rel.empty() ? map.string() : rel.string();
+          if (l.equalArea) j["mapping"] = "equal-area";
+        }
         break;
     }
     Json t = transform(l.placement);

@@ -47,6 +47,9 @@ void finalizeLight(Light& light) {
     case Light::Type::Directional:
     case Light::Type::Area:
       break;
+    case Light::Type::Environment:
+      if (light.env) light.power = light.env->integral();
+      break;
   }
   light.hasStillFrame = false;
   if (light.type == Light::Type::Area && !light.motion.moving()) {
@@ -123,6 +126,9 @@ bool sampleLight(const Light& light, Vec3f p, float time01, Vec2f u, LightSample
       out.pdf = areaLightPdf(light, f, p, q);
       return out.pdf > 0;
     }
+    case Light::Type::Environment:
+      out.distance = std::numeric_limits<float>::infinity();
+      return light.env->sample(u, out.wi, out.li, out.pdf);
   }
   return false;
 }
@@ -140,7 +146,7 @@ void boundingSphere(const Bounds3f& b, Vec3f& centre, float& radius) {
 }  // namespace
 
 Rgb emittedPower(const Light& light, const Bounds3f& sceneBounds) {
-  if (light.type == Light::Type::Directional) {
+  if (light.type == Light::Type::Directional || light.type == Light::Type::Environment) {
     Vec3f c;
     float r;
     boundingSphere(sceneBounds, c, r);
@@ -193,6 +199,24 @@ bool emitFromLight(const Light& light, float time01, const Bounds3f& sceneBounds
       out.direction = f.toWorld(squareToCosineHemisphere(uDir));
       // L * A * pi = power: cosine-weighted directions, uniform positions.
       out.flux = light.power;
+      return true;
+    }
+    case Light::Type::Environment: {
+      // A direction toward the sky by the map's luminance, then a point on
+      // the disc of the bounding sphere perpendicular to it, outside the
+      // sphere: E[flux] = pi r^2 * integral of L = emittedPower.
+      Vec3f w;
+      Rgb L;
+      float pdf;
+      if (!light.env->sample(uDir, w, L, pdf)) return false;
+      Vec3f c;
+      float r;
+      boundingSphere(sceneBounds, c, r);
+      Frame f(w);
+      Vec2f disk = squareToConcentricDisk(uPos);
+      out.origin = c + (f.s * disk.x + f.t * disk.y) * r + w * r;
+      out.direction = -w;
+      out.flux = L * (kPi * r * r / pdf);
       return true;
     }
   }

@@ -1,13 +1,15 @@
 // scene/light.h — the closed set of light sources (point, spot, directional,
-// rectangular area), each of which may move, with sampling for next-event
+// rectangular area, environment), each of which may move, with sampling for next-event
 // estimation. Photon emission sampling lives beside them (emitPhoton) so the
 // photon tracer and the path tracer share one definition of every light.
 #pragma once
 #include <cstdint>
+#include <memory>
 
 #include "math/bounds.h"
 #include "math/vec.h"
 #include "motion/motion.h"
+#include "scene/environment.h"
 
 namespace tdpm {
 
@@ -17,9 +19,11 @@ struct AreaLightFrame {
 };
 
 struct Light {
-  enum class Type : uint8_t { Point, Spot, Directional, Area };
+  enum class Type : uint8_t { Point, Spot, Directional, Area, Environment };
   Type type = Type::Point;
-  Rgb power{0.0f};           // W (point, spot, area); W/m^2 irradiance (directional)
+  // W (point, spot, area); W/m^2 irradiance (directional); environment:
+  // the integral of its radiance over the sphere (W/m^2, see emittedPower).
+  Rgb power{0.0f};
   Rgb intensity{0.0f};       // point, spot: W/sr on the axis
   Vec3f position{0, 0, 0};   // point, spot: before motion
   Vec3f direction{0, -1, 0}; // spot axis, directional travel direction: before motion
@@ -31,8 +35,10 @@ struct Light {
   // (areaLightFrame is asked for it at every light sample and every hit).
   bool hasStillFrame = false;
   AreaLightFrame stillFrame{};
+  // Environment: its radiance over directions (still: no motion).
+  std::shared_ptr<const EnvironmentMap> env;
 
-  bool isDelta() const { return type != Type::Area; }
+  bool isDelta() const { return type != Type::Area && type != Type::Environment; }
   // Spot falloff: 1 inside the inner cone, 0 outside the outer cone and a
   // quartic blend between (pbrt-v3's smoothstep-free form).
   float spotFalloff(float cosTheta) const;
@@ -64,6 +70,11 @@ bool sampleLight(const Light& light, Vec3f p, float time01, Vec2f u, LightSample
 // `hit` on an area light (for MIS when a BSDF-sampled ray hits it).
 float areaLightPdf(const Light& light, const AreaLightFrame& f, Vec3f p, Vec3f hit);
 
+// Environment light: radiance from world direction w (toward the sky) and
+// the solid-angle density with which sampleLight picks w.
+inline Rgb environmentRadiance(const Light& light, Vec3f w) { return light.env->radiance(w); }
+inline float environmentPdf(const Light& light, Vec3f w) { return light.env->pdf(w); }
+
 // ---- photon emission ----
 
 // The ray a photon leaves a light along. flux is the light's power over the
@@ -74,7 +85,9 @@ struct EmittedRay {
 };
 
 // Power (W) a light sends into the scene. A directional light's is its
-// irradiance times the area of the disc that covers the scene's bounds.
+// irradiance times the area of the disc that covers the scene's bounds; an
+// environment light's is that area times the integral of its radiance over
+// directions (pbrt-v4, Mitsuba), its photons leaving that disc.
 Rgb emittedPower(const Light& light, const Bounds3f& sceneBounds);
 // uPos, uDir: independent uniform 2D samples.
 bool emitFromLight(const Light& light, float time01, const Bounds3f& sceneBounds, Vec2f uPos, Vec2f uDir,

@@ -18,6 +18,7 @@
 #include "core/error.h"
 #include "math/bounds.h"
 #include "motion/motion.h"
+#include "scene/environment.h"
 #include "scene/json_locate.h"
 #include "scene/limits.h"
 #include "scene/mesh_obj.h"
@@ -543,6 +544,7 @@ const std::vector<LightKind>& lightKinds() {
       {"spot", LightDesc::Type::Spot, {"position", "target", "direction", "cone_angle", "falloff_start", "power"}},
       {"directional", LightDesc::Type::Directional, {"direction", "irradiance"}},
       {"area", LightDesc::Type::Area, {"size", "power"}},
+      {"environment", LightDesc::Type::Environment, {"L", "filename", "mapping", "scale"}},
   };
   return kinds;
 }
@@ -578,10 +580,47 @@ void readAreaSize(const Node& n, LightDesc* l) {
   l->areaSize = v;
 }
 
+// An environment light's radiance, scale and map (read and checked here, so
+// that a missing, empty or negative map is an error at its "filename").
+void readEnvironment(const Node& n, const std::string& sceneDir, LightDesc* l) {
+  if (n.has("motion")) n.member("motion").fail("an environment light does not move (give \"transform\" only)");
+  if (n.has("L")) l->radiance = n.member("L").color();
+  if (n.has("scale")) {
+    Node sc = n.member("scale");
+    l->scale = sc.number();
+    sc.require(l->scale >= 0 && std::isfinite(l->scale), "scale must be finite and non-negative, got " + fmt(l->scale));
+  }
+  if (n.has("mapping")) {
+    Node m = n.member("mapping");
+    if (!n.has("filename")) m.fail("\"mapping\" needs a \"filename\"");
+    l->equalArea = m.choice({"latlong", "equal-area"}, "environment mapping") == "equal-area";
+  }
+  if (!n.has("filename")) return;
+  Node f = n.member("filename");
+  std::string file = f.string();
+  f.require(!file.empty(), "environment map file name must not be empty");
+  l->mapFile = resolveMeshPath(file, sceneDir);
+  std::string problem;
+  std::shared_ptr<const image::ImageRgb> map = loadEnvironmentMap(l->mapFile, l->equalArea, &problem);
+  if (!map) f.fail(problem);
+  l->map = std::move(map);
+}
+
 // Where the renderer will put the light over the shutter (scene/build.cpp,
 // scene/light.cpp): in range, and an area light with a non-zero float area.
 void checkLightPlacement(const Node& n, const LightDesc& l, Shutter s) {
   if (l.type == LightDesc::Type::Directional) return;  // a direction only
+  if (l.type == LightDesc::Type::Environment) {        // a rotation (or mirror) only
+    checkScales(n, l.placement, l.motion);
+    // A stretch would make sampling densities in the light's frame wrong in
+    // the world's (pbrt ignores that Jacobian); a uniform scale changes nothing.
+    Vec3f a{std::fabs(l.placement.scale.x), std::fabs(l.placement.scale.y), std::fabs(l.placement.scale.z)};
+    if (a.x != a.y || a.y != a.z)
+      memberOr(memberOr(n, "transform"), "scale")
+          .fail("an environment light's transform may rotate and mirror it, not stretch it: scale " +
+                formatVec(l.placement.scale) + " is not uniform in magnitude");
+    return;
+  }
   checkScales(n, l.placement, l.motion);
   Motion m = motionOf(l.placement, l.motion, s);
   Bounds3f world;
@@ -601,7 +640,7 @@ void checkLightPlacement(const Node& n, const LightDesc& l, Shutter s) {
   }
 }
 
-LightDesc readLight(const Node& n, Shutter s) {
+LightDesc readLight(const Node& n, Shutter s, const std::string& sceneDir) {
   n.requireObject();
   std::vector<std::string> names;
   for (const auto& k : lightKinds()) names.push_back(k.name);
@@ -626,6 +665,7 @@ LightDesc readLight(const Node& n, Shutter s) {
   if (kind.type == LightDesc::Type::Directional && n.has("direction"))
     l.direction = readDirection(n.member("direction"));
   if (kind.type == LightDesc::Type::Spot) readSpot(n, &l);
+  if (kind.type == LightDesc::Type::Environment) readEnvironment(n, sceneDir, &l);
   if (n.has("size")) readAreaSize(n.member("size"), &l);
   if (n.has("transform")) l.placement = readTransform(n.member("transform"));
   if (n.has("motion")) l.motion = readMotion(n.member("motion"), s);
@@ -739,7 +779,7 @@ SceneDescription readScene(const Node& root, const std::string& sourcePath) {
   if (root.has("lights")) {
     Node lights = root.member("lights");
     size_t n = lights.arraySize("lights");
-    for (size_t i = 0; i < n; ++i) scene.lights.push_back(readLight(lights.element(i), shutter));
+    for (size_t i = 0; i < n; ++i) scene.lights.push_back(readLight(lights.element(i), shutter, sceneDir));
   }
   if (root.has("background")) scene.background = root.member("background").color();
   if (root.has("render"))

@@ -76,6 +76,7 @@ class Scene {
   std::vector<Material> materials;
   std::vector<SceneObject> objects;
   std::vector<Light> lights;
+  std::vector<uint32_t> environmentLights;  // indices into lights: what an escaping ray meets
   Rgb background{0.0f};
   Bounds3f bounds;                    // everything, over the whole shutter
   std::vector<Bounds3f> movingBounds; // swept bounds of each moving object / area light
