@@ -219,8 +219,14 @@ TEST_CASE("loop subdivision: boundary vertices stay on the boundary curve") {
   // pbrt's boundary limit 3/5 v + 1/5 (b0 + b1).
   scene::LoopMesh r = scene::loopSubdivide(flat.vertices, flat.indices, 0, kBudget);
   CHECK(gap(r.vertices[0], {0.2f, 0.2f, 0}) < 1e-6);
-  // A straight, uniform boundary keeps its interior boundary points in place.
-  CHECK(gap(r.vertices[2], {2, 0, 0}) < 1e-6);
+  // One level first: the corner's even rule 3/4 v + 1/8 (b0 + b1) gives
+  // (1/8, 1/8), its new boundary neighbours are the edge midpoints (1/2, 0)
+  // and (0, 1/2); the limit 3/5 (1/8, 1/8) + 1/5 (1/2, 1/2) = (0.175, 0.175).
+  scene::LoopMesh r1 = scene::loopSubdivide(flat.vertices, flat.indices, 1, kBudget);
+  CHECK(gap(r1.vertices[0], {0.175f, 0.175f, 0}) < 1e-6);
+  // A straight, uniform boundary keeps its points in place at every level.
+  for (int levels = 0; levels <= 3; ++levels)
+    CHECK(gap(scene::loopSubdivide(flat.vertices, flat.indices, levels, kBudget).vertices[2], {2, 0, 0}) < 1e-6);
 }
 
 TEST_CASE("loop subdivision: 4^levels triangles per control triangle, orientation kept per face") {
@@ -307,6 +313,10 @@ TEST_CASE("scene format: a mesh's \"subdivision\" key refines it; bad values are
   CHECK(e.find("134217728 triangles") != std::string::npos);
   e = error(jsonScene(R"(, "subdivision": {"scheme": "loop", "levels": -1})"));
   CHECK(e.find("levels must be >= 0") != std::string::npos);
+  e = error(jsonScene(R"(, "subdivision": {"scheme": "loop", "levels": 1.5})"));
+  CHECK(e.find("levels") != std::string::npos);
+  e = error(jsonScene(R"(, "subdivision": {"scheme": "loop", "levels": 1000})"));
+  CHECK(e.find("more than the limit") != std::string::npos);
   e = error(jsonScene(R"(, "subdivision": {"scheme": "catmull-clark", "levels": 1})"));
   CHECK(e.find("scheme") != std::string::npos);
   e = error(jsonScene(R"(, "subdivision": {"scheme": "loop", "levels": 1, "crease": 2})"));
@@ -369,6 +379,10 @@ TEST_CASE("pbrt loopsubdiv: imports, renders as its refined triangles, converts 
   std::string noLevels = withLevels("3");
   noLevels.replace(noLevels.find("\"integer levels\" 3"), 18, "");
   CHECK(pbrt::importPbrtText(noLevels, "dir/loop.pbrt").scene.objects[0].shape.loopLevels == 3);
+  // pbrt-v3's older spelling.
+  std::string nlevels = withLevels("2");
+  nlevels.replace(nlevels.find("\"integer levels\""), 16, "\"integer nlevels\"");
+  CHECK(pbrt::importPbrtText(nlevels, "dir/loop.pbrt").scene.objects[0].shape.loopLevels == 2);
 }
 
 TEST_CASE("pbrt loopsubdiv: negative levels, the budget and non-manifold meshes are located errors") {
