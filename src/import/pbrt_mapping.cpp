@@ -11,6 +11,8 @@
 #include "import/ply_reader.h"
 #include "scene/environment.h"
 #include "scene/json_writer.h"
+#include "scene/limits.h"
+#include "scene/subdivision.h"
 
 namespace tdpm::pbrt::detail {
 
@@ -390,6 +392,7 @@ struct Geometry {
   std::vector<Vec3f> vertices;
   std::vector<uint32_t> indices;
   std::vector<Vec2f> uv;  // per vertex, when the file gives them (or a single bilinear patch's defaults)
+  int loopLevels = -1;    // loopsubdiv: the control mesh above, refined by scene/build.cpp
 };
 }  // namespace
 
@@ -438,6 +441,26 @@ static void addQuads(const std::vector<Vec3f>& P, const std::vector<uint32_t>& q
       failAt(at, what + ": quad " + std::to_string(i / 4) + " is not a flat parallelogram (pbrt-v3 and v4 would render it differently)");
     triangles->insert(triangles->end(), {quads[i], quads[i + 1], quads[i + 2], quads[i], quads[i + 2], quads[i + 3]});
   }
+}
+
+// pbrt's "integer levels" (default 3; pbrt-v3 also reads the older
+// "nlevels"), checked against the refined-triangle budget before anything
+// is refined.
+static int readLoopLevels(const ParamSet& ps, size_t triangles, const Loc& at) {
+  const char* name = ps.has("levels") || !ps.has("nlevels") ? "levels" : "nlevels";
+  const Param* p = ps.find(name);
+  if (ps.has("nlevels") && ps.has("levels")) ps.fail(*ps.find("nlevels"), "give \"levels\" or \"nlevels\", not both");
+  int levels = ps.getInt(name, 3);
+  if (levels < 0) ps.fail(*p, "levels must be >= 0, got " + std::to_string(levels));
+  uint64_t refined = scene::loopTriangleCount(triangles, levels);
+  if (refined > scene::limits::kMaxSubdividedTriangles) {
+    std::string what = std::to_string(levels) + " levels refine the " + std::to_string(triangles) + " triangles to " +
+                       (refined == UINT64_MAX ? std::string("more than 2^64") : std::to_string(refined)) +
+                       " triangles, more than tdpm's limit of " + std::to_string(scene::limits::kMaxSubdividedTriangles);
+    if (p) ps.fail(*p, what);
+    failAt(at, "Shape \"loopsubdiv\": " + what + " (the default is 3 levels)");
+  }
+  return levels;
 }
 
 // `inputs` collects the files read (PLY meshes).
@@ -510,8 +533,15 @@ static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(co
     g.vertices = std::move(ply.vertices);
     g.indices = std::move(ply.triangles);
     addQuads(g.vertices, ply.quads, rec.at, "Shape \"plymesh\" \"" + file + "\"", &g.indices);
+  } else if (rec.type == "loopsubdiv") {
+    g.vertices = readPoints(ps, "P", rec.at);
+    g.indices = readIndices(ps, g.vertices.size(), 3, "triangle", rec.at);
+    g.loopLevels = readLoopLevels(ps, g.indices.size() / 3, rec.at);
+    std::string problem = scene::loopTopologyProblem(g.indices, g.vertices.size());
+    if (!problem.empty()) failAt(rec.at, "Shape \"loopsubdiv\": " + problem);
+    note("Shape \"loopsubdiv\": shaded with the refined triangles' geometric normals, not pbrt's limit-surface normals");
   } else {
-    failAt(rec.at, "Shape \"" + rec.type + "\" is not supported (sphere, trianglemesh, bilinearmesh, plymesh)");
+    failAt(rec.at, "Shape \"" + rec.type + "\" is not supported (sphere, trianglemesh, bilinearmesh, plymesh, loopsubdiv)");
   }
   ps.checkAllUsed();
   return g;
@@ -642,7 +672,12 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
   const MaterialSlot& mat = materials_[size_t(rec.material)];
   if (rec.area) {
     if (g.sphere) failAt(rec.at, "Shape \"sphere\" with an AreaLightSource: tdpm's area lights are rectangles");
-    emitAreaLight(rec, g.vertices, g.indices, ctm);
+    if (g.loopLevels >= 0) {
+      scene::LoopMesh m = scene::loopSubdivide(g.vertices, g.indices, g.loopLevels, scene::limits::kMaxSubdividedTriangles);
+      emitAreaLight(rec, m.vertices, m.indices, ctm);
+    } else {
+      emitAreaLight(rec, g.vertices, g.indices, ctm);
+    }
     return;
   }
   if (mat.interface) return;  // no surface: invisible without participating media
@@ -670,6 +705,7 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
   } else {
     o.shape.type = scene::ShapeDesc::Type::Mesh;
     o.shape.indices = g.indices;
+    o.shape.loopLevels = g.loopLevels;  // placements are affine: refining after baking them is exact
     if (mat.checker) {
       if (plan.moving) failAt(rec.at, "a moving shape with a checkerboard is not supported");
       if (g.uv.empty()) failAt(rec.at, "a checkerboard needs per-vertex \"uv\" (or a single bilinear patch)");

@@ -5,7 +5,9 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "scene/limits.h"
 #include "scene/scene.h"
+#include "scene/subdivision.h"
 
 namespace tdpm {
 
@@ -145,7 +147,16 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
       switch (od.shape.type) {
         case ShapeDesc::Type::Quad: mesh = makeQuad(od.shape.size.x, od.shape.size.z); break;
         case ShapeDesc::Type::Box: mesh = makeBox(od.shape.size); break;
-        default: mesh = {od.shape.vertices, od.shape.indices}; break;
+        default:
+          if (od.shape.loopLevels >= 0) {
+            // parse.cpp and the pbrt import checked topology and budget.
+            scene::LoopMesh refined = scene::loopSubdivide(od.shape.vertices, od.shape.indices, od.shape.loopLevels,
+                                             scene::limits::kMaxSubdividedTriangles);
+            mesh = {std::move(refined.vertices), std::move(refined.indices)};
+          } else {
+            mesh = {od.shape.vertices, od.shape.indices};
+          }
+          break;
       }
       for (Vec3f v : mesh.vertices) o.objectBounds.extend(v);
       o.faceNormals.reserve(mesh.indices.size() / 3);

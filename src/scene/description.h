@@ -65,6 +65,9 @@ struct ShapeDesc {
   // Mesh: triangles loaded from meshFile (object space).
   std::vector<Vec3f> vertices;
   std::vector<uint32_t> indices;  // 3 per triangle
+  // Mesh: Loop subdivision levels (scene/subdivision.h), -1 for none. The
+  // vertices and indices above stay the control mesh; scene/build.cpp refines.
+  int loopLevels = -1;
 };
 
 struct ObjectDesc {

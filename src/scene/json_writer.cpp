@@ -204,6 +204,8 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
         std::string name = stem + ".mesh" + std::to_string(out.meshFiles.size()) + ".obj";
         out.meshFiles.push_back({(jp.parent_path() / name).string(), meshText ? objText(s) : std::string()});
         j["shape"] = Json{{"type", "mesh"}, {"file", name}};
+        // The control mesh and its levels: the reader refines exactly as the import did.
+        if (s.loopLevels >= 0) j["shape"]["subdivision"] = Json{{"scheme", "loop"}, {"levels", s.loopLevels}};
         break;
       }
     }

@@ -20,6 +20,10 @@ constexpr uint64_t kMaxSceneFileBytes = uint64_t(16) << 20;  // 16 MiB
 // A mesh file larger than this is refused before it is read (an OBJ line
 // costs ~30-60 bytes per vertex/face; 1 GiB is ~20M triangles).
 constexpr uint64_t kMaxMeshFileBytes = uint64_t(1) << 30;  // 1 GiB
+// Most triangles one subdivided mesh may refine to (4^levels x its
+// triangles): about what the largest mesh file holds, so that a small file
+// asking for many levels cannot ask for more memory than a large one.
+constexpr uint64_t kMaxSubdividedTriangles = uint64_t(1) << 24;
 // Deepest nesting of arrays/objects in a scene file. The deepest valid key
 // path is 6 levels (objects[i].motion[j].rotate.axis[k]); checked before
 // nlohmann-json parses, since nlohmann's parser recurses.

@@ -22,6 +22,7 @@
 #include "scene/json_locate.h"
 #include "scene/limits.h"
 #include "scene/mesh_obj.h"
+#include "scene/subdivision.h"
 #include "scene/parse_animation.h"
 #include "scene/parse_node.h"
 #include "scene/render_method.h"
@@ -439,6 +440,25 @@ std::string resolveMeshPath(const std::string& file, const std::string& sceneDir
 
 // Set while parseScene(text, path, meshes) runs (on this thread only).
 thread_local const MeshSource* tMeshSource = nullptr;
+// "subdivision": {"scheme": "loop", "levels": N}: the topology and the
+// refined size are checked here, so that building cannot fail.
+void readSubdivision(const Node& n, ShapeDesc* shape) {
+  n.requireObject();
+  n.expectObject({"scheme", "levels"});
+  n.required("scheme").choice({"loop"}, "subdivision scheme");
+  Node levels = n.required("levels");
+  int64_t l = levels.integer();
+  levels.require(l >= 0, "levels must be >= 0 (0 is the control mesh moved to its limit surface), got " + std::to_string(l));
+  uint64_t tris = loopTriangleCount(shape->indices.size() / 3, int(std::min<int64_t>(l, 64)));
+  levels.require(tris <= limits::kMaxSubdividedTriangles,
+                 std::to_string(l) + " levels refine the " + std::to_string(shape->indices.size() / 3) + " triangles to " +
+                     (tris == UINT64_MAX ? std::string("more than 2^64") : std::to_string(tris)) +
+                     " triangles, more than the limit of " + std::to_string(limits::kMaxSubdividedTriangles) +
+                     " (docs/scene-format.md, \"Limits\")");
+  std::string problem = loopTopologyProblem(shape->indices, shape->vertices.size());
+  n.require(problem.empty(), "the mesh cannot be Loop-subdivided: " + problem);
+  shape->loopLevels = int(l);
+}
 
 void readMesh(const Node& n, const std::string& sceneDir, ShapeDesc* shape) {
   Node fileNode = n.required("file");
@@ -454,6 +474,7 @@ void readMesh(const Node& n, const std::string& sceneDir, ShapeDesc* shape) {
   if (!loadObjMesh(shape->meshFile, &mesh, &problem)) fileNode.fail(problem);
   shape->vertices = std::move(mesh.vertices);
   shape->indices = std::move(mesh.indices);
+  if (n.has("subdivision")) readSubdivision(n.member("subdivision"), shape);
 }
 
 ShapeDesc readShape(const Node& n, const std::string& sceneDir) {
@@ -488,7 +509,7 @@ ShapeDesc readShape(const Node& n, const std::string& sceneDir) {
       checkPoint(sz, s.size * 0.5f, "half size");
     }
   } else {
-    n.expectObject({"type", "file"});
+    n.expectObject({"type", "file", "subdivision"});
     s.type = ShapeDesc::Type::Mesh;
     readMesh(n, sceneDir, &s);
   }
