@@ -1,4 +1,4 @@
-// tests/test_dist.cpp — the distribution module (dist/) and the render's
+// tests/test_dist.cpp — the distribution module (distributed/) and the render's
 // split of work, without MPI: block ranges of photon batches, the tile
 // interleave, pixel sharing with one process, error agreement, launcher
 // detection, Nagle off on the link to the launcher. The multi-process runs are in tests/test_dist_mpi.cpp.
@@ -20,8 +20,8 @@
 
 #include <tbb/task_arena.h>
 
-#include "dist/comm.h"
-#include "dist/launcher_link.h"
+#include "distributed/comm.h"
+#include "distributed/launcher_link.h"
 #include "render/pixel_share.h"
 #include "render/tile_loop.h"
 

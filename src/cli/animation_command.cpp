@@ -18,7 +18,7 @@
 
 #include "cli/frame_pattern.h"
 #include "cli/path_names.h"
-#include "dist/comm.h"
+#include "distributed/comm.h"
 #include "cli/progress_bar.h"
 #include "cli/render_metadata.h"
 #include "core/atomic_file.h"

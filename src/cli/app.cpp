@@ -17,7 +17,7 @@
 #include "cli/convert_command.h"
 #include "cli/render_command.h"
 #include "core/error.h"
-#include "dist/comm.h"
+#include "distributed/comm.h"
 
 namespace tdpm::cli {
 

@@ -4,11 +4,11 @@
 // run(), so in-process tests keep the default behaviour.
 #include "cli/app.h"
 #include "core/signals.h"
-#include "dist/comm.h"
+#include "distributed/comm.h"
 
 int main(int argc, char** argv) {
   tdpm::signals::install(tdpm::signals::Mode::Exit);
-  // MPI starts only when mpirun launched this process (dist/comm.h): a
+  // MPI starts only when mpirun launched this process (distributed/comm.h): a
   // plain run never needs a launcher.
   tdpm::dist::Session mpi(argc, argv);
   if (!mpi.ok()) return 1;

@@ -16,7 +16,7 @@
 #include <string>
 
 #include "cli/render_command.h"
-#include "dist/comm.h"
+#include "distributed/comm.h"
 #include "render/renderer.h"
 #include "scene/description.h"
 

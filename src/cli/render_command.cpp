@@ -30,7 +30,7 @@
 #include "core/signals.h"
 #include "core/memory.h"
 #include "core/timer.h"
-#include "dist/comm.h"
+#include "distributed/comm.h"
 #include "image/exr.h"
 #include "image/png.h"
 #include "import/pbrt_import.h"

@@ -13,7 +13,7 @@
 #include <limits>
 
 #include "core/error.h"
-#include "dist/comm.h"
+#include "distributed/comm.h"
 #include "photon/knn_heap.h"
 
 namespace tdpm::photon {

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "core/progress.h"
-#include "dist/comm.h"
+#include "distributed/comm.h"
 #include "photon/store.h"
 #include "sampling/sampler.h"
 #include "scene/scene.h"
@@ -41,7 +41,7 @@ struct TraceSettings {
   SamplerKind sampler = SamplerKind::Random;
   // Distributed: every rank traces a contiguous block of the batches (pilot
   // included) and receives everyone's photons in batch order, so each rank
-  // holds the map one process would trace (dist/comm.h).
+  // holds the map one process would trace (distributed/comm.h).
   dist::Comm* comm = &dist::local();
   // Animations (render/animation.h) trace the timeline in segments: path
   // times spread over [timeOpen, timeClose] (scene seconds, inside the

@@ -8,7 +8,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "dist/comm.h"
+#include "distributed/comm.h"
 #include "render/tile_loop.h"
 
 namespace tdpm {

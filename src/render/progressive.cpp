@@ -20,7 +20,7 @@
 #include "core/rng.h"
 #include "core/signals.h"
 #include "core/timer.h"
-#include "dist/comm.h"
+#include "distributed/comm.h"
 #include "estimate/estimators.h"
 #include "photon/tracer.h"
 #include "render/camera_sample.h"

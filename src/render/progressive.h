@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "core/progress.h"
-#include "dist/comm.h"
+#include "distributed/comm.h"
 #include "estimate/fixed_kernel.h"
 #include "render/film.h"
 #include "render/progressive_state.h"

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "core/progress.h"
-#include "dist/comm.h"
+#include "distributed/comm.h"
 #include "estimate/estimators.h"
 #include "motion/shutter.h"
 #include "render/film.h"

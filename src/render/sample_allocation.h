@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "core/progress.h"
-#include "dist/comm.h"
+#include "distributed/comm.h"
 #include "render/render_options.h"
 #include "scene/scene.h"
 

@@ -4,7 +4,7 @@
 // a per-thread scratch object it may reuse (no allocation per sample, no
 // locks). Progress is reported once per finished tile. Results must depend
 // only on the pixel (seeded per pixel), so they are identical for any
-// thread count and any tile order. A distributed render (dist/) either
+// thread count and any tile order. A distributed render (distributed/) either
 // hands the tiles out as the ranks ask for them (forEachClaimedTile: a
 // queue, which absorbs ranks running at different speeds) or gives each
 // rank the tiles its TileShare owns (a fixed interleave).

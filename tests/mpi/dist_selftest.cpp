@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "dist/comm.h"
-#include "dist/launcher_link.h"
+#include "distributed/comm.h"
+#include "distributed/launcher_link.h"
 #include "photon/kdtree.h"
 #include "render/pixel_share.h"
 
@@ -147,7 +147,7 @@ int main(int argc, char** argv) {
   }
 
   // Session turned Nagle off on this rank's link to the launcher's PMIx
-  // server (dist/launcher_link.h): under Open MPI's mpirun there is one.
+  // server (distributed/launcher_link.h): under Open MPI's mpirun there is one.
   {
     std::vector<dist::TcpEndpoint> servers = dist::pmixServerEndpoints();
     bool allNoDelay = false;

@@ -1,6 +1,6 @@
-// dist/comm.cpp — the one-process Comm, the helpers built on any Comm, the
-// launcher detection and the MPI session (dist/mpi_comm.cpp does the MPI).
-#include "dist/comm.h"
+// distributed/comm.cpp — the one-process Comm, the helpers built on any Comm, the
+// launcher detection and the MPI session (distributed/mpi_comm.cpp does the MPI).
+#include "distributed/comm.h"
 
 #include <unistd.h>
 
@@ -10,7 +10,7 @@
 #include <cstring>
 
 #ifdef TDPM_MPI
-#include "dist/mpi_backend.h"
+#include "distributed/mpi_backend.h"
 #endif
 
 namespace tdpm::dist {

@@ -1,4 +1,4 @@
-// dist/mpi_comm.cpp — the Comm of an `mpirun` job, on MPI_COMM_WORLD: the
+// distributed/mpi_comm.cpp — the Comm of an `mpirun` job, on MPI_COMM_WORLD: the
 // only file of tdpm that includes mpi.h (compiled only with TDPM_MPI).
 // Collectives run on the main thread only; the shared counter of the tile
 // queue is called from TBB workers too, one call at a time behind its mutex
@@ -15,9 +15,9 @@
 #include <exception>
 #include <mutex>
 
-#include "dist/comm.h"
-#include "dist/launcher_link.h"
-#include "dist/mpi_backend.h"
+#include "distributed/comm.h"
+#include "distributed/launcher_link.h"
+#include "distributed/mpi_backend.h"
 
 namespace tdpm::dist {
 
@@ -211,7 +211,7 @@ Comm* start(int& argc, char**& argv) {
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_SERIALIZED, &provided);
   // MPI_Init connected this rank to the launcher's PMIx server: no Nagle on
-  // that link, or MPI_Finalize sleeps ~40 ms (dist/launcher_link.h).
+  // that link, or MPI_Finalize sleeps ~40 ms (distributed/launcher_link.h).
   setNoDelayOnConnectionsTo(pmixServerEndpoints());
   gComm = new MpiComm();
   return gComm;

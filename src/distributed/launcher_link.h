@@ -1,4 +1,4 @@
-// dist/launcher_link.h — the TCP connection between a rank and its
+// distributed/launcher_link.h — the TCP connection between a rank and its
 // launcher's PMIx server (Open MPI's mpirun / orted, or any PMIx launcher),
 // found from the launcher's environment (PMIX_SERVER_URI*), and Nagle's
 // algorithm turned off on it.

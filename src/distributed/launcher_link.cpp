@@ -1,6 +1,6 @@
-// dist/launcher_link.cpp — finds the rank's connection to the PMIx server
+// distributed/launcher_link.cpp — finds the rank's connection to the PMIx server
 // and turns off Nagle's algorithm on it (why: launcher_link.h).
-#include "dist/launcher_link.h"
+#include "distributed/launcher_link.h"
 
 #include <arpa/inet.h>
 #include <dirent.h>

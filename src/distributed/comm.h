@@ -1,8 +1,8 @@
-// dist/comm.h — the processes of a distributed render (docs/distributed.md).
+// distributed/comm.h — the processes of a distributed render (docs/distributed.md).
 // Owns the one interface the rest of tdpm uses to talk to the other ranks of
 // an `mpirun` job: who am I (rank, size), collectives on plain bytes
 // (allgather / gather to rank 0 / broadcast / integer sums), agreement on an
-// error, and ending the whole job. dist/mpi_comm.cpp is the only file that
+// error, and ending the whole job. distributed/mpi_comm.cpp is the only file that
 // includes mpi.h; without MPI (TDPM_MPI=OFF, or a plain run without mpirun)
 // world() is a one-process Comm whose collectives are copies.
 //

@@ -1,4 +1,4 @@
-// dist/mpi_backend.h — what dist/comm.cpp needs from dist/mpi_comm.cpp, the
+// distributed/mpi_backend.h — what distributed/comm.cpp needs from distributed/mpi_comm.cpp, the
 // one file that includes mpi.h (compiled only when TDPM_MPI is on).
 #pragma once
 
