@@ -133,6 +133,8 @@ class Importer {
   void requireWorld(const Loc& at, const std::string& stmt) const;
   void requireOptions(const Loc& at, const std::string& stmt) const;
   void mapPixelFilter(scene::RenderSettings& r, bool v4Film);
+  // Camera "perspective" lensradius / focaldistance (pbrt_camera.cpp).
+  void readThinLens(const ParamSet& ps);
 
   GraphicsState gs_;
   std::vector<StackEntry> stack_;
@@ -152,6 +154,7 @@ class Importer {
   Mat cameraCtm_[2];
   bool mirror_ = true;
   float shutterOpen_ = 0, shutterClose_ = 1;
+  double lensRadius_ = 0, focalDistance_ = 1e6;  // camera space; pbrt's defaults
   double imagingRatio_ = 1;  // pbrt-v4 film: exposure time * ISO / 100
   Loc worldAt_;
 

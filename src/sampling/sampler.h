@@ -16,6 +16,7 @@
 // id, never by a running counter, so a branch that skips a draw does not
 // shift what later vertices see:
 //   camera:      kCameraGroup      3D: pixel x, pixel y (in the pixel), time
+//                kCameraLens       2D: the thin lens's point (camera.lens_radius)
 //   vertex v (v = 0 is the camera ray's first hit), vertexGroup(v, slot):
 //     kLightChoice   1D  which light (reserved: every light is sampled today)
 //     kLightPosition 2D  point on the light, per light (sub = light index)
@@ -56,6 +57,7 @@ namespace dims {
 constexpr uint32_t kCameraGroup = 0;
 enum Slot : uint32_t { kLightChoice = 0, kLightPosition, kBsdf, kRoulette, kGather, kSlotsPerVertex };
 constexpr uint32_t kPhotonLight = 1, kPhotonPosition = 2, kPhotonDirection = 3, kPhotonTime = 4;
+constexpr uint32_t kCameraLens = 5;
 constexpr uint32_t kFirstVertexGroup = 8;
 // Group id of `slot` at path vertex `vertex`; `sub` tells apart several
 // draws of one slot (lights, gather rays).
@@ -149,6 +151,13 @@ class RandomPixelSampler {
     first_ = first;
     camera_.resize(size_t(count));
     stratifiedCameraSamples(count, rng_, camera_.data(), strata_);
+    // The lens point: a Latin hypercube of its own from its own generator,
+    // so the path stream (rng_) is the one a pinhole render always drew.
+    lens_.resize(size_t(count));
+    Rng lensRng;
+    lensRng.reseed(hashCombine(hashCombine(seed_, pixel_, first), 0x1e25ull), 0);
+    stratifiedCameraSamples(count, lensRng, lens_.data(), strata_);
+    for (size_t k = 0; k < camera_.size(); ++k) camera_[k].lens = lens_[k].pixelOffset;
   }
   CameraSample camera(uint32_t i) const { return camera_[i - first_]; }
   Stream stream(uint32_t) { return {&rng_}; }
@@ -157,7 +166,7 @@ class RandomPixelSampler {
   uint64_t seed_, pixel_;
   uint32_t first_ = 0;
   Rng rng_;
-  std::vector<CameraSample> camera_;
+  std::vector<CameraSample> camera_, lens_;
   std::vector<uint32_t> strata_;
 };
 
@@ -168,8 +177,9 @@ class SobolPixelSampler {
   void startBatch(uint32_t, int) {}
   Stream stream(uint32_t i) const { return {pixelSeed_, i}; }
   CameraSample camera(uint32_t i) const {
-    Vec3f u = stream(i).get3D(dims::kCameraGroup);
-    return {{u.x, u.y}, u.z};
+    Stream s = stream(i);
+    Vec3f u = s.get3D(dims::kCameraGroup);
+    return {{u.x, u.y}, u.z, s.get2D(dims::kCameraLens)};
   }
 
  private:
