@@ -571,7 +571,7 @@ TEST_CASE("pbrt errors name file:line and the statement or parameter") {
       {"Integrator \"bdpt\"\nWorldBegin\n", "dir/t.pbrt:1: Integrator \"bdpt\" is not supported"},
       {"WorldBegin\nMaterial \"uber\"\n", "dir/t.pbrt:2: material type \"uber\" is not supported"},
       {"WorldBegin\nMaterial \"metal\"\n", "dir/t.pbrt:2: metal: give \"rgb eta\" and \"rgb k\""},
-      {"WorldBegin\nMaterial \"matte\" \"spectrum Kd\" [400 0.5 700 0.5]\n", "spectral values are not supported"},
+      {"WorldBegin\nMaterial \"matte\" \"spectrum Kd\" [700 0.5 400 0.5]\n", "dir/t.pbrt:2: Material \"matte\": parameter \"spectrum Kd\": wavelengths must increase"},
       {"WorldBegin\nMaterial \"glass\" \"rgb Kr\" [1 1 1] \"rgb Kt\" [0.5 0.5 0.5]\n", "dir/t.pbrt:2: glass: Kr and Kt differ"},
       {"WorldBegin\nLightSource \"goniometric\"\n", "dir/t.pbrt:2: LightSource \"goniometric\" is not supported"},
       {"WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.exr\"\n", "dir/t.pbrt:2: LightSource \"infinite\": an environment map"},

@@ -128,6 +128,10 @@ class Importer {
   std::string uniqueMaterialName(const std::string& base);
   Rgb color(const ParamSet& ps, const std::string& name, Rgb fallback) const;
   double floatParam(const ParamSet& ps, const std::string& name, double fallback) const;
+  // "spectrum" / "blackbody" values reduced to RGB or to one number (an eta)
+  // once, at load (pbrt_spectrum.cpp, import/spectrum.h).
+  Rgb spectrumColor(const ParamSet& ps, const Param& p) const;
+  double spectrumFloat(const ParamSet& ps, const Param& p) const;
   Rgb lightScale(const ParamSet& ps) const;
   void note(const Loc& at, const std::string& what);
   void requireWorld(const Loc& at, const std::string& stmt) const;

@@ -39,9 +39,8 @@ Rgb Importer::color(const ParamSet& ps, const std::string& name, Rgb fallback) c
     if (it->second.checker) ps.fail(*p, "a checkerboard is supported only as the reflectance of diffuse or plastic materials");
     return it->second.value;
   }
-  if (p->type == "spectrum" || p->type == "blackbody")
-    ps.fail(*p, "spectral values are not supported; give \"rgb " + name + "\"");
-  ps.fail(*p, "expected rgb, float or texture");
+  if (p->type == "spectrum" || p->type == "blackbody") return spectrumColor(ps, *p);
+  ps.fail(*p, "expected rgb, float, spectrum, blackbody or texture");
 }
 
 double Importer::floatParam(const ParamSet& ps, const std::string& name, double fallback) const {
@@ -53,10 +52,7 @@ double Importer::floatParam(const ParamSet& ps, const std::string& name, double 
     if (it == textures_.end() || !it->second.isFloat) ps.fail(*p, "expected a float texture");
     return it->second.value.r;
   }
-  if (p->type == "spectrum" && p->numbers.size() == 1) {  // v4 allows a constant spectrum for eta
-    p->used = true;
-    return p->numbers[0];
-  }
+  if (p->type == "spectrum") return spectrumFloat(ps, *p);  // v4: a spectral eta (a constant, a named glass, ...)
   return ps.getFloat(name, fallback);
 }
 
