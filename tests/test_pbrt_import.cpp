@@ -570,7 +570,7 @@ TEST_CASE("pbrt errors name file:line and the statement or parameter") {
       {"Camera \"orthographic\"\nWorldBegin\n", "dir/t.pbrt:1: Camera \"orthographic\" is not supported"},
       {"Integrator \"bdpt\"\nWorldBegin\n", "dir/t.pbrt:1: Integrator \"bdpt\" is not supported"},
       {"WorldBegin\nMaterial \"uber\"\n", "dir/t.pbrt:2: material type \"uber\" is not supported"},
-      {"WorldBegin\nMaterial \"metal\"\n", "dir/t.pbrt:2: metal: give \"rgb eta\" and \"rgb k\""},
+      {"WorldBegin\nMaterial \"conductor\" \"spectrum eta\" \"metal-CuZn-eta\"\n", "dir/t.pbrt:2: Material \"conductor\": parameter \"spectrum eta\": named spectrum \"metal-CuZn-eta\" is not available"},
       {"WorldBegin\nMaterial \"matte\" \"spectrum Kd\" [700 0.5 400 0.5]\n", "dir/t.pbrt:2: Material \"matte\": parameter \"spectrum Kd\": wavelengths must increase"},
       {"WorldBegin\nMaterial \"glass\" \"rgb Kr\" [1 1 1] \"rgb Kt\" [0.5 0.5 0.5]\n", "dir/t.pbrt:2: glass: Kr and Kt differ"},
       {"WorldBegin\nLightSource \"goniometric\"\n", "dir/t.pbrt:2: LightSource \"goniometric\" is not supported"},

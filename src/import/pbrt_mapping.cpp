@@ -161,9 +161,12 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     if (!v3 && ps.has("reflectance")) {
       r0 = color(ps, "reflectance", Rgb(1.0f));
     } else {
-      if (!ps.has("eta") || !ps.has("k"))
-        failAt(at, label + ": give \"rgb eta\" and \"rgb k\" (pbrt's default is spectral copper, which tdpm cannot represent)");
-      Rgb eta = color(ps, "eta", Rgb(1.0f)), k = color(ps, "k", Rgb(0.0f));
+      // pbrt's default is copper (pbrt_spectrum.cpp: v3 reduces its copper
+      // against equal-energy white, v4 its metal-Cu under D65).
+      bool filmV3 = v3 || (film_.given && film_.type == "image");
+      Rgb cuEta = filmV3 ? Rgb(0.200964f, 0.923779f, 1.102306f) : Rgb(0.105133f, 0.977933f, 1.204671f);
+      Rgb cuK = filmV3 ? Rgb(3.912923f, 2.453080f, 2.142269f) : Rgb(3.273486f, 2.592516f, 2.369186f);
+      Rgb eta = color(ps, "eta", cuEta), k = color(ps, "k", cuK);
       for (int i = 0; i < 3; ++i) r0[i] = reflectanceAtNormal(eta[i], k[i]);
     }
     checkReflectance(ps, "reflectance", r0);

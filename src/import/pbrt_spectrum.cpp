@@ -34,6 +34,28 @@ double bk7(double nm) {
   return std::sqrt(n2);
 }
 
+// pbrt-v4's named metal spectra, reduced once to RGB (linear sRGB, seen
+// under D65 as pbrt-v4 sees non-light spectra) with import/spectrum.h's
+// matching functions. The data are pbrt-v4's tables (src/pbrt/util/
+// spectrum.cpp: Ag, Al, Au, Cu on one 298.8-885.6 nm grid, the measured
+// optical constants pbrt-v3 also ships; MgO, TiO2), read, integrated over
+// 360-830 nm at 1 nm and kept here as the triples only. Reducing the same Cu
+// and Au data against equal-energy white instead gives (0.2010, 0.9238,
+// 1.1023)/(3.913, 2.453, 2.142) and (0.1430, 0.3753, 1.4422)/(3.983, 2.386,
+// 1.603), the RGB values pbrt-v3-era scenes use for copper and gold to 5e-4.
+struct NamedRgb {
+  const char* name;
+  Rgb rgb;
+};
+const NamedRgb kNamedMetals[] = {
+    {"metal-Ag-eta", {0.128478f, 0.123535f, 0.150894f}},   {"metal-Ag-k", {4.064805f, 3.286218f, 2.391785f}},
+    {"metal-Al-eta", {1.407383f, 0.926656f, 0.584076f}},   {"metal-Al-k", {7.740226f, 6.602473f, 5.360401f}},
+    {"metal-Au-eta", {0.079954f, 0.405088f, 1.560861f}},   {"metal-Au-k", {3.390203f, 2.503536f, 1.771026f}},
+    {"metal-Cu-eta", {0.105133f, 0.977933f, 1.204671f}},   {"metal-Cu-k", {3.273486f, 2.592516f, 2.369186f}},
+    {"metal-MgO-eta", {1.733677f, 1.740950f, 1.753548f}},  {"metal-MgO-k", {0.0f, 0.0f, 0.0f}},
+    {"metal-TiO2-eta", {2.860379f, 2.956533f, 3.185532f}}, {"metal-TiO2-k", {0.000091f, 0.0f, 0.000566f}},
+};
+
 bool looksNamed(const std::string& s) {
   for (const char* prefix : {"metal-", "glass-", "stdillum-", "illum-", "canon_", "nikon_", "sony_", "ciexyz"})
     if (s.rfind(prefix, 0) == 0) return true;
@@ -69,8 +91,8 @@ static spectrum::Piecewise readPairs(const ParamSet& ps, const Param& p, bool v3
       return s;
     }
     if (looksNamed(name))
-      ps.fail(p, "named spectrum \"" + name + "\" is not available in tdpm (only stdillum-D65 and glass-BK7 are; " +
-                     "tdpm has no trustworthy table for the others): give an rgb value instead");
+      ps.fail(p, "named spectrum \"" + name + "\" is not available in tdpm (it has stdillum-D65, glass-BK7, glass-BAF10 " +
+                     "and metal-{Ag,Al,Au,Cu,MgO,TiO2}-{eta,k}; no trustworthy table for the others): give an rgb value instead");
     std::string path = resolvePath(name, ps.file(), mainDir);
     std::string text = readWholeFile(path, ps.file() + ":" + std::to_string(p.line) + ": " + ps.statement() +
                                                ": parameter \"" + p.type + " " + p.name + "\": ");
@@ -121,6 +143,9 @@ static spectrum::Piecewise readPairs(const ParamSet& ps, const Param& p, bool v3
 
 Rgb Importer::spectrumColor(const ParamSet& ps, const Param& p) const {
   p.used = true;
+  if (p.strings.size() == 1)
+    for (const NamedRgb& n : kNamedMetals)
+      if (p.strings[0] == n.name) return n.rgb;
   bool filmV3 = film_.given && film_.type == "image";
   bool v3 = filmV3;
   spectrum::Piecewise s;
@@ -157,6 +182,9 @@ Rgb Importer::spectrumColor(const ParamSet& ps, const Param& p) const {
 double Importer::spectrumFloat(const ParamSet& ps, const Param& p) const {
   p.used = true;
   if (p.strings.empty() && p.numbers.size() == 1) return p.numbers[0];  // v4: a constant
+  // glass-BAF10: pbrt-v4's table (refractiveindex.info, CC0), its y-bar
+  // weighted mean computed as below, once.
+  if (p.strings.size() == 1 && p.strings[0] == "glass-BAF10") return 1.67259;
   bool v3 = film_.given && film_.type == "image";
   bool constant = false;
   double value = 0;
