@@ -170,7 +170,7 @@ void renderPassPixels(const Scene& scene, const PhotonIntegrator& integ, const R
           if (fixedTime01 >= 0) cs.time01 = fixedTime01;
           else if (!scene.hasMotion) cs.time01 = 0.0f;
           Vec2f p = filter.sample(cs.pixelOffset);  // filter importance sampling: weight 1
-          cam.generateRay({float(x) + p.x, float(y) + p.y}, cs.time01, cs.lens, o, d);
+          cam.generateRay({float(x) + p.x, float(y) + p.y}, cs.time01, lensSample(cam, ps, i), o, d);
           return cs.time01;
         };
         Rgb v;

@@ -137,7 +137,7 @@ void samplePass(const Scene& scene, const Integrator& integrator, const Sampling
           else cs.time01 = plan.time01Lo + cs.time01 * (plan.time01Hi - plan.time01Lo);  // whole shutter: unchanged
           Vec3f o, d;
           Vec2f p = plan.filter.sample(cs.pixelOffset);  // filter importance sampling: weight 1
-          cam.generateRay({float(x) + p.x, float(y) + p.y}, cs.time01, cs.lens, o, d);
+          cam.generateRay({float(x) + p.x, float(y) + p.y}, cs.time01, lensSample(cam, ps, i), o, d);
           typename PixelSampler::Stream stream = ps.stream(i);
           Rgb L = integrator.radiance(o, d, cs.time01, stream, s.state);
           // A NaN sample is a bug upstream; never let it reach the film. An

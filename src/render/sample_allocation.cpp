@@ -49,7 +49,7 @@ std::vector<float> pilotNoise(const Scene& scene, const RenderOptions& opt, cons
           if (!scene.hasMotion) cs.time01 = 0.0f;
           Vec3f o, d;
           Vec2f p = filter.sample(cs.pixelOffset);
-          scene.camera.generateRay({float(x) + p.x, float(y) + p.y}, cs.time01, cs.lens, o, d);
+          scene.camera.generateRay({float(x) + p.x, float(y) + p.y}, cs.time01, lensSample(scene.camera, ps, i), o, d);
           SobolStream stream = ps.stream(i);
           Rgb L = saturateSample(eyeOnly.radiance(o, d, cs.time01, stream, s.state));
           double l = std::min(double(L.luminance()), 1e30);

@@ -136,7 +136,8 @@ struct SobolStream {
 
 // ---- per-pixel samplers (the pixel loop's side) ----
 // startBatch(first, count) before a batch of sample indices first..first+count-1;
-// then for each: stream(i) and camera(i) (pixel offset + time of sample i).
+// then for each: stream(i) and camera(i) (pixel offset + time of sample i),
+// and lens(i) (the thin lens's point) when the camera has a lens.
 
 class RandomPixelSampler {
  public:
@@ -151,22 +152,22 @@ class RandomPixelSampler {
     first_ = first;
     camera_.resize(size_t(count));
     stratifiedCameraSamples(count, rng_, camera_.data(), strata_);
-    // The lens point: a Latin hypercube of its own from its own generator,
-    // so the path stream (rng_) is the one a pinhole render always drew.
-    lens_.resize(size_t(count));
-    Rng lensRng;
-    lensRng.reseed(hashCombine(hashCombine(seed_, pixel_, first), 0x1e25ull), 0);
-    stratifiedCameraSamples(count, lensRng, lens_.data(), strata_);
-    for (size_t k = 0; k < camera_.size(); ++k) camera_[k].lens = lens_[k].pixelOffset;
   }
   CameraSample camera(uint32_t i) const { return camera_[i - first_]; }
+  // The thin lens's point of sample i, asked for only by a thin-lens camera:
+  // hashed from (seed, pixel, i), not drawn from rng_, so the path stream is
+  // the one a pinhole render always drew. Independent uniform, not stratified.
+  Vec2f lens(uint32_t i) const {
+    uint64_t h = hashCombine(hashCombine(seed_, pixel_, i), 0x1e25ull);
+    return {bitsToFloat01(uint32_t(h)), bitsToFloat01(uint32_t(h >> 32))};
+  }
   Stream stream(uint32_t) { return {&rng_}; }
 
  private:
   uint64_t seed_, pixel_;
   uint32_t first_ = 0;
   Rng rng_;
-  std::vector<CameraSample> camera_, lens_;
+  std::vector<CameraSample> camera_;
   std::vector<uint32_t> strata_;
 };
 
@@ -177,10 +178,10 @@ class SobolPixelSampler {
   void startBatch(uint32_t, int) {}
   Stream stream(uint32_t i) const { return {pixelSeed_, i}; }
   CameraSample camera(uint32_t i) const {
-    Stream s = stream(i);
-    Vec3f u = s.get3D(dims::kCameraGroup);
-    return {{u.x, u.y}, u.z, s.get2D(dims::kCameraLens)};
+    Vec3f u = stream(i).get3D(dims::kCameraGroup);
+    return {{u.x, u.y}, u.z};
   }
+  Vec2f lens(uint32_t i) const { return stream(i).get2D(dims::kCameraLens); }
 
  private:
   uint64_t pixelSeed_;

@@ -15,7 +15,6 @@ namespace tdpm {
 struct CameraSample {
   Vec2f pixelOffset;  // in [0,1)^2 within the pixel
   float time01;       // normalised shutter time in [0,1)
-  Vec2f lens{0.5f, 0.5f};  // thin-lens point in [0,1)^2 (the pixel sampler's dims::kCameraLens); centre: pinhole
 };
 
 // Fills out[0..n) (out must hold n). `scratch` avoids allocation per pixel.

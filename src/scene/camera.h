@@ -7,6 +7,7 @@
 // forward), so that plane is sharp and a point at depth d is a disc of
 // diameter 2 r |d - f| / d on the focal plane (docs/scene-format.md).
 #pragma once
+#include <cstdint>
 #include <vector>
 
 #include "math/vec.h"
@@ -49,5 +50,13 @@ class Camera {
   float lensRadius_ = 0.0f, focalDistance_ = 1.0f;
   Pose stillPose_{};  // a camera with one key: its pose, made once (every camera ray asks)
 };
+
+// The lens point of sample i: the pixel sampler's kCameraLens draw for a
+// thin lens, not drawn at all for a pinhole (whose rays ignore it), so a
+// pinhole render costs what it did before the lens existed.
+template <class PixelSampler>
+Vec2f lensSample(const Camera& cam, const PixelSampler& ps, uint32_t i) {
+  return cam.thinLens() ? ps.lens(i) : Vec2f{0.5f, 0.5f};
+}
 
 }  // namespace tdpm
