@@ -231,3 +231,34 @@ TEST_CASE("thin lens: pbrt lensradius / focaldistance / focusdistance, scaled by
   }
   CHECK(e.find("lens.pbrt:2: Camera \"perspective\": parameter \"float focusdistance\": both") == 0);
 }
+
+TEST_CASE("thin lens: tdpm convert writes the lens and the reduced spectra; the JSON renders the same pixels") {
+  const char* text = R"(LookAt 0 1 5  0 0 0  0 1 0
+Camera "perspective" "float fov" 40 "float lensradius" 0.2 "float focaldistance" 3
+Film "rgb" "integer xresolution" 24 "integer yresolution" 16
+WorldBegin
+LightSource "point" "blackbody I" [3200] "point3 from" [0 3 2]
+Material "diffuse" "spectrum reflectance" [360 0.2 500 0.7 830 0.3]
+AttributeBegin
+Translate 0 -101 0
+Shape "sphere" "float radius" 100
+AttributeEnd
+Material "conductor" "spectrum eta" "metal-Au-eta" "spectrum k" "metal-Au-k" "float roughness" 0.3
+Shape "sphere" "float radius" 0.7
+)";
+  scene::SceneDescription d = pbrt::importPbrtText(text, "lens.pbrt").scene;
+  CHECK(d.camera.lensRadius == doctest::Approx(0.2f));
+  pbrt::SceneJson j = pbrt::sceneToJson(d, "lens.json");
+  scene::SceneDescription back = scene::parseScene(j.json, "lens.json");
+  CHECK(back.camera.lensRadius == d.camera.lensRadius);
+  CHECK(back.camera.focalDistance == d.camera.focalDistance);
+  Film a = renderPt(d, 8), b = renderPt(back, 8);
+  double sum = 0;
+  bool same = a.color.size() == b.color.size();
+  for (size_t i = 0; same && i < a.color.size(); ++i) {
+    same = a.color[i].r == b.color[i].r && a.color[i].g == b.color[i].g && a.color[i].b == b.color[i].b;
+    sum += a.color[i].g;
+  }
+  CHECK(same);
+  CHECK(sum > 0);
+}
