@@ -345,8 +345,8 @@ TEST_CASE("scene parse: required keys, unknown keys, wrong types") {
             "unknown key \"objets\" (did you mean \"objects\"?); allowed keys: animation, background, camera, lights, "
             "materials, objects, render");
   checkEdit([](Json& j) { j["camera"]["positon"] = {0, 0, 0}; }, "camera.positon",
-            "unknown key \"positon\" (did you mean \"position\"?); allowed keys: fov, motion, position, resolution, "
-            "shutter, target, up");
+            "unknown key \"positon\" (did you mean \"position\"?); allowed keys: focal_distance, fov, lens_radius, "
+            "motion, position, resolution, shutter, target, up");
   checkEdit([](Json& j) { j["objects"][0]["shape"]["colour"] = 1; }, "objects[0].shape.colour",
             "unknown key \"colour\"; allowed keys: radius, type");
   checkEdit([](Json& j) { j["camera"] = "front"; }, "camera", "expected an object, got a string");

@@ -594,9 +594,7 @@ void Importer::worldBegin(const Loc& at) {
     shutterClose_ = float(ps.getFloat("shutterclose", 1));
     if (shutterClose_ < shutterOpen_)
       failAt(camera_.at, "Camera: shutterclose (" + fmtNum(shutterClose_) + ") is before shutteropen (" + fmtNum(shutterOpen_) + ")");
-    double lens = ps.getFloat("lensradius", 0);
-    if (lens > 0) ps.fail(*ps.find("lensradius"), "depth of field (lensradius > 0) is not supported");
-    ps.markUsed("focaldistance");
+    readThinLens(ps);
     ps.checkAllUsed();
   }
   });
@@ -624,6 +622,11 @@ void Importer::worldBegin(const Loc& at) {
     bool similar = p && std::fabs(std::fabs(p->scale.x) - std::fabs(p->scale.y)) <= 1e-5f * std::fabs(p->scale.x) &&
                    std::fabs(std::fabs(p->scale.x) - std::fabs(p->scale.z)) <= 1e-5f * std::fabs(p->scale.x);
     if (!similar) failAt(camAt, "Camera: the camera transform has shear or non-uniform scale, which distorts the image; not supported");
+    // pbrt's lens radius and focal distance are camera-space lengths.
+    if (i == 0) {
+      sc.camera.lensRadius = float(lensRadius_ * std::fabs(p->scale.x));
+      sc.camera.focalDistance = float(focalDistance_ * std::fabs(p->scale.x));
+    }
   }
   // pbrt's camera looks down +z with +x to the image's right and +y up:
   // a left-handed frame when C is a proper rotation. tdpm's camera is

@@ -134,6 +134,10 @@ class Importer {
   std::string uniqueMaterialName(const std::string& base);
   Rgb color(const ParamSet& ps, const std::string& name, Rgb fallback) const;
   double floatParam(const ParamSet& ps, const std::string& name, double fallback) const;
+  // "spectrum" / "blackbody" values reduced to RGB or to one number (an eta)
+  // once, at load (pbrt_spectrum.cpp, import/spectrum.h).
+  Rgb spectrumColor(const ParamSet& ps, const Param& p) const;
+  double spectrumFloat(const ParamSet& ps, const Param& p) const;
   Rgb lightScale(const ParamSet& ps) const;
   void noteLightSamples(const ParamSet& ps, const Loc& at, const std::string& what);
   void note(const Loc& at, const std::string& what);
@@ -142,6 +146,8 @@ class Importer {
   void mapPixelFilter(scene::RenderSettings& r, bool v4Film);
   void checkNesting(const Loc& at, const std::string& stmt) const;
   void countTriangles(uint64_t n, const Loc& at, const std::string& what, bool add = true);
+  // Camera "perspective" lensradius / focaldistance (pbrt_camera.cpp).
+  void readThinLens(const ParamSet& ps);
 
   GraphicsState gs_;
   std::vector<StackEntry> stack_;
@@ -177,6 +183,7 @@ class Importer {
   Mat cameraCtm_[2];
   bool mirror_ = true;
   float shutterOpen_ = 0, shutterClose_ = 1;
+  double lensRadius_ = 0, focalDistance_ = 1e6;  // camera space; pbrt's defaults
   double imagingRatio_ = 1;  // pbrt-v4 film: exposure time * ISO / 100; pbrt-v3 image film: "scale"
   std::string filmFactorWhat_ = "pbrt-v4 scales the image by exposure time x ISO / 100";
   // pbrt-v3 syntax (Film "image"): notes about pbrt-v4-only behaviour are left out.

@@ -42,9 +42,8 @@ Rgb Importer::color(const ParamSet& ps, const std::string& name, Rgb fallback) c
     if (it->second.checker) ps.fail(*p, "a checkerboard is supported only as the reflectance of diffuse or plastic materials");
     return it->second.value;
   }
-  if (p->type == "spectrum" || p->type == "blackbody")
-    ps.fail(*p, "spectral values are not supported; give \"rgb " + name + "\"");
-  ps.fail(*p, "expected rgb, float or texture");
+  if (p->type == "spectrum" || p->type == "blackbody") return spectrumColor(ps, *p);
+  ps.fail(*p, "expected rgb, float, spectrum, blackbody or texture");
 }
 
 double Importer::floatParam(const ParamSet& ps, const std::string& name, double fallback) const {
@@ -56,10 +55,7 @@ double Importer::floatParam(const ParamSet& ps, const std::string& name, double 
     if (it == textures_.end() || !it->second.isFloat) ps.fail(*p, "expected a float texture");
     return it->second.value.r;
   }
-  if (p->type == "spectrum" && p->numbers.size() == 1) {  // v4 allows a constant spectrum for eta
-    p->used = true;
-    return p->numbers[0];
-  }
+  if (p->type == "spectrum") return spectrumFloat(ps, *p);  // v4: a spectral eta (a constant, a named glass, ...)
   return ps.getFloat(name, fallback);
 }
 
@@ -168,9 +164,12 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     if (!v3 && ps.has("reflectance")) {
       r0 = color(ps, "reflectance", Rgb(1.0f));
     } else {
-      if (!ps.has("eta") || !ps.has("k"))
-        failAt(at, label + ": give \"rgb eta\" and \"rgb k\" (pbrt's default is spectral copper, which tdpm cannot represent)");
-      Rgb eta = color(ps, "eta", Rgb(1.0f)), k = color(ps, "k", Rgb(0.0f));
+      // pbrt's default is copper (pbrt_spectrum.cpp: v3 reduces its copper
+      // against equal-energy white, v4 its metal-Cu under D65).
+      bool filmV3 = v3 || (film_.given && film_.type == "image");
+      Rgb cuEta = filmV3 ? Rgb(0.200964f, 0.923779f, 1.102306f) : Rgb(0.105133f, 0.977933f, 1.204671f);
+      Rgb cuK = filmV3 ? Rgb(3.912923f, 2.453080f, 2.142269f) : Rgb(3.273486f, 2.592516f, 2.369186f);
+      Rgb eta = color(ps, "eta", cuEta), k = color(ps, "k", cuK);
       for (int i = 0; i < 3; ++i) r0[i] = reflectanceAtNormal(eta[i], k[i]);
     }
     checkReflectance(ps, "reflectance", r0);

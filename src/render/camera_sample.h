@@ -1,14 +1,15 @@
 // render/camera_sample.h — the one camera sample: (pixel, sample index,
 // sampling plan) -> the camera ray, its time and where in the pixel it
-// landed (pbrt-v4's GetCameraSample + GenerateRay, Mitsuba's render_sample).
+// landed, through the lens (pbrt-v4's GetCameraSample + GenerateRay, Mitsuba's render_sample).
 // Every pixel loop takes its rays from cameraRay(): the fixed-budget and
 // adaptive passes (render/renderer.cpp), the progressive pass
 // (render/progressive.cpp) and the eye-only pilot (render/sample_allocation.cpp),
 // so the time remap (a still scene, an accumulation frame's instant, an
 // animation frame's part of the timeline) is written once, here.
 //
-// The camera is a pinhole (scene/camera.h): there is no lens sample. The
-// pixel filter is importance sampled (sampling/filter.h), so every sample's
+// A thin-lens camera (scene/camera.h) takes its lens point from the
+// sampler's lens dimensions (lensSample: drawn only when the camera has a
+// lens, so a pinhole render draws what it always drew). The pixel filter is importance sampled (sampling/filter.h), so every sample's
 // filter weight is 1 and nothing is multiplied.
 #pragma once
 #include <cstdint>
@@ -57,7 +58,7 @@ inline CameraRay cameraRay(const Camera& camera, const CameraSamplePlan& plan, c
   CameraRay r;
   r.time01 = plan.times.remap(cs.time01);
   const Vec2f p = plan.filter.sample(cs.pixelOffset);
-  camera.generateRay({float(x) + p.x, float(y) + p.y}, r.time01, r.origin, r.direction);
+  camera.generateRay({float(x) + p.x, float(y) + p.y}, r.time01, lensSample(camera, ps, index), r.origin, r.direction);
   return r;
 }
 

@@ -16,6 +16,7 @@
 // id, never by a running counter, so a branch that skips a draw does not
 // shift what later vertices see:
 //   camera:      kCameraGroup      3D: pixel x, pixel y (in the pixel), time
+//                kCameraLens       2D: the thin lens's point (camera.lens_radius)
 //   vertex v (v = 0 is the camera ray's first hit), vertexGroup(v, slot):
 //     kLightChoice   1D  which light (reserved: every light is sampled today)
 //     kLightPosition 2D  point on the light, per light (sub = light index)
@@ -56,6 +57,7 @@ namespace dims {
 constexpr uint32_t kCameraGroup = 0;
 enum Slot : uint32_t { kLightChoice = 0, kLightPosition, kBsdf, kRoulette, kGather, kSlotsPerVertex };
 constexpr uint32_t kPhotonLight = 1, kPhotonPosition = 2, kPhotonDirection = 3, kPhotonTime = 4;
+constexpr uint32_t kCameraLens = 5;
 constexpr uint32_t kFirstVertexGroup = 8;
 // Group id of `slot` at path vertex `vertex`; `sub` tells apart several
 // draws of one slot (lights, gather rays).
@@ -134,7 +136,8 @@ struct SobolStream {
 
 // ---- per-pixel samplers (the pixel loop's side) ----
 // startBatch(first, count) before a batch of sample indices first..first+count-1;
-// then for each: stream(i) and camera(i) (pixel offset + time of sample i).
+// then for each: stream(i) and camera(i) (pixel offset + time of sample i),
+// and lens(i) (the thin lens's point) when the camera has a lens.
 
 class RandomPixelSampler {
  public:
@@ -151,6 +154,13 @@ class RandomPixelSampler {
     stratifiedCameraSamples(count, rng_, camera_.data(), strata_);
   }
   CameraSample camera(uint32_t i) const { return camera_[i - first_]; }
+  // The thin lens's point of sample i, asked for only by a thin-lens camera:
+  // hashed from (seed, pixel, i), not drawn from rng_, so the path stream is
+  // the one a pinhole render always drew. Independent uniform, not stratified.
+  Vec2f lens(uint32_t i) const {
+    uint64_t h = hashCombine(hashCombine(seed_, pixel_, i), 0x1e25ull);
+    return {bitsToFloat01(uint32_t(h)), bitsToFloat01(uint32_t(h >> 32))};
+  }
   Stream stream(uint32_t) { return {&rng_}; }
 
  private:
@@ -171,6 +181,7 @@ class SobolPixelSampler {
     Vec3f u = stream(i).get3D(dims::kCameraGroup);
     return {{u.x, u.y}, u.z};
   }
+  Vec2f lens(uint32_t i) const { return stream(i).get2D(dims::kCameraLens); }
 
  private:
   uint64_t pixelSeed_;

@@ -3,10 +3,13 @@
 
 #include <cmath>
 
+#include "sampling/warp.h"
+
 namespace tdpm {
 
 Camera::Camera(const scene::CameraDesc& d)
-    : shutter_{d.shutterOpen, d.shutterClose}, width_(d.width), height_(d.height) {
+    : shutter_{d.shutterOpen, d.shutterClose}, width_(d.width), height_(d.height),
+      lensRadius_(d.lensRadius), focalDistance_(d.focalDistance) {
   tanHalfFov_ = std::tan(0.5f * d.fovDegrees * kPi / 180.0f);
   aspect_ = float(d.width) / float(d.height);
   if (d.motion.empty()) keys_ = {{d.shutterOpen, d.position, d.target, d.up}};
@@ -49,6 +52,20 @@ void Camera::generateRay(Vec2f raster, float time01, Vec3f& origin, Vec3f& direc
   float y = (1.0f - 2.0f * raster.y / float(height_)) * tanHalfFov_;
   origin = p.position;
   direction = normalize(p.forward + p.right * x + p.up * y);
+}
+
+void Camera::generateRay(Vec2f raster, float time01, Vec2f lens, Vec3f& origin, Vec3f& direction) const {
+  if (lensRadius_ <= 0) return generateRay(raster, time01, origin, direction);
+  Pose p = poseAt(time01);
+  float x = (2.0f * raster.x / float(width_) - 1.0f) * tanHalfFov_ * aspect_;
+  float y = (1.0f - 2.0f * raster.y / float(height_)) * tanHalfFov_;
+  // The pinhole direction has forward component 1, so scaling it by the
+  // focal distance lands on the focal plane (pbrt's thin lens, in world space).
+  Vec3f focus = (p.forward + p.right * x + p.up * y) * focalDistance_;
+  Vec2f l = squareToConcentricDisk(lens);
+  Vec3f offset = p.right * (l.x * lensRadius_) + p.up * (l.y * lensRadius_);
+  origin = p.position + offset;
+  direction = normalize(focus - offset);
 }
 
 bool Camera::project(Vec3f w, float time01, Vec2f& raster) const {

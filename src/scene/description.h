@@ -119,6 +119,10 @@ struct CameraDesc {
   int width = 640, height = 480;  // >= 1 each
   float shutterOpen = 0.0f, shutterClose = 1.0f;  // close >= open
   std::vector<CameraKeyframe> motion;  // empty: static; else >= 2, times increasing, inside the shutter
+  // Thin lens (depth of field): lens radius in metres (0: pinhole) and the
+  // distance along the view direction of the plane in focus (> 0).
+  float lensRadius = 0.0f;
+  float focalDistance = 1.0f;
 };
 
 // Render settings stored in the scene. Each is optional: command-line flags

@@ -183,6 +183,10 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
       m.push_back(Json{{"time", num(k.time)}, {"position", vec(k.position)}, {"target", vec(k.target)}, {"up", vec(k.up)}});
     cam["motion"] = m;
   }
+  if (c.lensRadius > 0) {
+    cam["lens_radius"] = num(c.lensRadius);
+    cam["focal_distance"] = num(c.focalDistance);
+  }
   root["camera"] = cam;
   Json materials = Json::object();
   for (const auto& m : sc.materials) {

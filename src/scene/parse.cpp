@@ -282,8 +282,29 @@ std::vector<CameraKeyframe> readCameraMotion(const Node& n, const CameraDesc& ca
   return keys;
 }
 
+// Thin lens: lens_radius >= 0 (0: pinhole), focal_distance > 0, by default
+// the distance from position to target (the point looked at is in focus).
+void readLens(const Node& n, CameraDesc* cam) {
+  cam->focalDistance = length(cam->target - cam->position);
+  if (n.has("lens_radius")) {
+    Node r = n.member("lens_radius");
+    cam->lensRadius = r.number();
+    r.require(cam->lensRadius >= 0, "lens_radius must be >= 0 (0: a pinhole camera), got " + fmt(cam->lensRadius));
+    r.require(cam->lensRadius <= limits::kMaxCoordinate,
+              "lens_radius " + fmt(cam->lensRadius) + " is too large; lengths must be " + coordinateRange());
+  }
+  if (n.has("focal_distance")) {
+    Node f = n.member("focal_distance");
+    cam->focalDistance = f.number();
+    f.require(cam->focalDistance > 0, "focal_distance must be > 0 (metres along the view direction), got " +
+                                          fmt(cam->focalDistance));
+    f.require(cam->focalDistance <= limits::kMaxCoordinate,
+              "focal_distance " + fmt(cam->focalDistance) + " is too large; lengths must be " + coordinateRange());
+  }
+}
+
 CameraDesc readCamera(const Node& n, const std::optional<AnimationDesc>& animation) {
-  n.expectObject({"position", "target", "up", "fov", "resolution", "shutter", "motion"});
+  n.expectObject({"position", "target", "up", "fov", "resolution", "shutter", "motion", "lens_radius", "focal_distance"});
   CameraDesc cam;
   if (animation) {
     // The animation's timeline is the shutter every keyframe lives in.
@@ -307,6 +328,7 @@ CameraDesc readCamera(const Node& n, const std::optional<AnimationDesc>& animati
     readShutter(n.member("shutter"), &cam);
   }
   if (n.has("motion")) cam.motion = readCameraMotion(n.member("motion"), cam, animation ? "the animation" : "the shutter");
+  readLens(n, &cam);
   return cam;
 }
 
