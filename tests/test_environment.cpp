@@ -29,6 +29,7 @@
 #include "scene/light.h"
 #include "scene/parse.h"
 #include "scene/scene.h"
+#include "render_fixtures.h"
 
 using namespace tdpm;
 
@@ -75,17 +76,10 @@ std::string sphereScene(float albedo, const std::string& light) {
 
 Film renderWith(const scene::SceneDescription& d, const std::string& method, int spp, int maxDepth,
                 size_t globalPhotons = 40000) {
-  auto s = Scene::build(d);
-  RenderOptions o;
-  o.method = *parseRenderMethod(method);
-  o.spp = spp;
-  o.maxSpp = spp;
-  o.maxDepth = maxDepth;
-  o.seed = 11;
+  RenderOptions o = test::smallRenderOptions(*parseRenderMethod(method), spp, maxDepth, 11);
   o.causticPhotons = 0;
   o.globalPhotons = globalPhotons;
-  RenderStats st;
-  return render(*s, o, Progress{}, st);
+  return test::renderOnce(d, o);
 }
 
 // Mean and standard error of the mean over the pixels of a square crop.

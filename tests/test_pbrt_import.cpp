@@ -31,6 +31,7 @@
 #include "scene/material.h"
 #include "scene/parse.h"
 #include "scene/scene.h"
+#include "render_fixtures.h"
 
 using namespace tdpm;
 
@@ -47,32 +48,14 @@ std::string errorOf(const std::string& text, const std::string& file = "dir/t.pb
 }
 
 Film renderDesc(const scene::SceneDescription& d, const std::string& method = "pathtrace", int spp = 4) {
-  auto s = Scene::build(d);
-  RenderOptions o;
-  o.method = *parseRenderMethod(method);
-  o.spp = spp;
-  o.maxSpp = spp;
-  o.maxDepth = 4;
-  o.seed = 7;
+  RenderOptions o = test::smallRenderOptions(*parseRenderMethod(method), spp, 4, 7);
   o.causticPhotons = 2000;
   o.globalPhotons = 2000;
-  RenderStats st;
-  return render(*s, o, Progress{}, st);
+  return test::renderOnce(d, o);
 }
 
-// Bit-identical images.
-bool sameImage(const Film& a, const Film& b) {
-  if (a.width != b.width || a.height != b.height) return false;
-  for (size_t i = 0; i < a.color.size(); ++i)
-    if (a.color[i].r != b.color[i].r || a.color[i].g != b.color[i].g || a.color[i].b != b.color[i].b) return false;
-  return true;
-}
-
-double sum(const Film& f) {
-  double s = 0;
-  for (const Rgb& c : f.color) s += c.r + c.g + c.b;
-  return s;
-}
+using test::sameImage;
+double sum(const Film& f) { return test::imageSum(f); }
 
 // Writes the description as JSON (and OBJ meshes) into a temp dir and parses it back.
 scene::SceneDescription roundTrip(const scene::SceneDescription& d, const std::string& name) {

@@ -25,6 +25,7 @@
 #include "scene/parse.h"
 #include "scene/scene.h"
 #include "scene/subdivision.h"
+#include "render_fixtures.h"
 
 using namespace tdpm;
 
@@ -89,28 +90,11 @@ std::string tempDir(const std::string& name) {
 
 void writeFile(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
 
+using test::sameImage;
+double sum(const Film& f) { return test::imageSum(f); }
+
 Film renderDesc(const scene::SceneDescription& d) {
-  auto s = Scene::build(d);
-  RenderOptions o;
-  o.method = RenderMethod::PathTrace;
-  o.spp = o.maxSpp = 2;
-  o.maxDepth = 3;
-  o.seed = 11;
-  RenderStats st;
-  return render(*s, o, Progress{}, st);
-}
-
-bool sameImage(const Film& a, const Film& b) {
-  if (a.width != b.width || a.height != b.height) return false;
-  for (size_t i = 0; i < a.color.size(); ++i)
-    if (a.color[i].r != b.color[i].r || a.color[i].g != b.color[i].g || a.color[i].b != b.color[i].b) return false;
-  return true;
-}
-
-double sum(const Film& f) {
-  double s = 0;
-  for (const Rgb& c : f.color) s += c.r + c.g + c.b;
-  return s;
+  return test::renderOnce(d, test::smallRenderOptions(RenderMethod::PathTrace, 2, 3, 11));
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "scene/camera.h"
 #include "scene/json_writer.h"
 #include "scene/parse.h"
+#include "render_fixtures.h"
 #include "scene_fixtures.h"
 
 using namespace tdpm;
@@ -42,15 +43,9 @@ scene::SceneDescription sphereAtDepth(float d, float rho, float lensRadius, floa
 }
 
 Film renderPt(const scene::SceneDescription& d, int spp, SamplerKind sampler = SamplerKind::Sobol) {
-  auto s = Scene::build(d);
-  RenderOptions o;
-  o.method = RenderMethod::PathTrace;
-  o.spp = spp;
-  o.maxDepth = 2;
-  o.seed = 11;
+  RenderOptions o = test::smallRenderOptions(RenderMethod::PathTrace, spp, 2, 11);
   o.sampler = sampler;
-  RenderStats st;
-  return render(*s, o, Progress{}, st);
+  return test::renderOnce(d, o);
 }
 
 // Moments of the occlusion 1 - I about the image centre, in pixels.
