@@ -66,6 +66,9 @@ using FrameSink = std::function<void(int frame, Film&& film, const RenderStats& 
 // Renders options.first..options.last. Methods: time, standard, pathtrace
 // (others are refused with an Error). `--photons` counts are per frame's
 // shutter time. Reports progress.at(WorkPosition{"frame", ...}).
+// options.progressive: each frame is a progressive render (time, standard;
+// --passes / --time-limit per frame), its passes' photons and camera samples
+// in the frame's shutter; the window and segments are not used.
 AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& animation, const RenderOptions& options,
                                const AnimationOptions& animationOptions, const Progress& progress,
                                const FrameSink& sink);
