@@ -141,6 +141,36 @@ TEST_CASE("progressive animation frame: converges to the fixed-budget frame's me
   CHECK(std::fabs(mp.mean - want) < std::fabs(mp.mean - other) / 4.0);
 }
 
+TEST_CASE("progressive animation frame: every pass's photons are the frame's own shutter's") {
+  // tests/test_animation.cpp's still plane under a light that moves far
+  // away over the timeline: the standard estimate ignores time, so a frame
+  // in passes follows its own frame's lighting only if every pass traces
+  // its photons over that frame's shutter (over the timeline it would give
+  // the timeline's average to every frame).
+  auto d = planeAnimation();
+  d.objects[0].motion = scene::MotionDesc{};
+  d.lights[0].motion = test::translation({0, 0, 0}, {0, 2, 0});  // up 2 m over the timeline: 1/d^2 falls
+  auto s = Scene::build(d);
+  RenderOptions o = progressiveOptions(5, 6);
+  o.method = RenderMethod::Standard;
+  Frames q = renderFrames(*s, *d.animation, o, 0, 3);
+  REQUIRE(q.films.size() == 4);
+  for (int i : {0, 3}) {
+    Shutter fs = frameShutter(*d.animation, i);
+    double want = 0;  // irradiance at the centre pixels' plane point, averaged over the frame
+    const int nt = 64;
+    for (int k = 0; k < nt; ++k) {
+      double t = fs.open + (fs.close - fs.open) * (k + 0.5) / nt;
+      double h = 2.0 + 2.0 * t;
+      want += test::kMovingPlaneRho / kPi * test::kMovingPlaneIntensity / (h * h) / nt;
+    }
+    const Film& f = q.films[size_t(i)];
+    double got = (f.color[f.index(3, 3)].r + f.color[f.index(4, 4)].r + f.color[f.index(3, 4)].r + f.color[f.index(4, 3)].r) / 4;
+    MESSAGE("progressive frame " << i << ": centre / analytic = " << got / want);
+    CHECK(got / want == doctest::Approx(1.0).epsilon(0.06));  // frame 0 is 2.3x frame 3: far outside
+  }
+}
+
 TEST_CASE("progressive animation frames: --passes per frame, a frame's image whatever the range") {
   auto d = planeAnimation();
   auto s = Scene::build(d);
