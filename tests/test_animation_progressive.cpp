@@ -205,6 +205,7 @@ TEST_CASE("render CLI: --progressive renders an animation's frames in passes; --
   INFO(r.output);
   REQUIRE(r.exitCode == 0);
   for (int i : {0, 1, 2}) CHECK(test::fileExists(dir + "/out/f_" + std::to_string(i) + ".exr"));
+  CHECK(r.output.find("stored in 6 passes") != std::string::npos);  // 2 passes for each of the 3 frames
   int before = test::countEntries(dir);
   auto bad = test::runTdpm("render '" + scene + "' -o '" + dir + "/out2/f_#.exr' --progressive --passes 2 --resume '" +
                            dir + "/out/f_0.exr' --spp 1 --photons 100 --global-photons 100");

@@ -131,6 +131,7 @@ AnimationStats renderProgressiveFrames(const Scene& scene, const scene::Animatio
     stats.causticEmitted += st.causticEmitted;
     stats.globalEmitted += st.globalEmitted;
     emitted += st.causticEmitted + st.globalEmitted;
+    stats.passesDone += uint64_t(state.passesDone);
     sink(i, std::move(film), st);
     progress.at(WorkPosition{"frame", size_t(i - ao.first + 1), total, 0, emitted});
   }
