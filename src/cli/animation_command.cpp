@@ -228,12 +228,13 @@ void printAnimationSummary(const RenderArgs& a, const RenderOptions& opt, const 
     double all = allSeconds;
     std::fprintf(stderr,
                  "tdpm: %s, %s: %d frames (%d-%d) at %dx%d, %.2f s in all, %.2f s per frame; photons: %llu caustic, "
-                 "%llu global stored in %llu segments, %.2f s%s%s\n",
+                 "%llu global stored in %llu %s, %.2f s%s%s\n",
                  a.scene.c_str(), renderMethodName(opt.method), f.range.count(), f.range.first, f.range.last,
                  scene.camera.width(), scene.camera.height(), all, all / double(f.range.count()),
                  static_cast<unsigned long long>(stats.causticStored),
                  static_cast<unsigned long long>(stats.globalStored),
-                 static_cast<unsigned long long>(stats.segmentsTraced), stats.photonSeconds,
+                 static_cast<unsigned long long>(opt.progressive ? stats.passesDone : stats.segmentsTraced),
+                 opt.progressive ? "passes" : "segments", stats.photonSeconds,
                  a.video ? " -> video " : "", a.video ? a.video->c_str() : "");
   }
   if (a.stats) {

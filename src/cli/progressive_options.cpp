@@ -37,11 +37,11 @@ void addProgressiveOptions(CLI::App* c, RenderArgs& a) {
               "Render with one photon budget, not in passes: overrides the default for a scene's own photon method "
               "and a render block's \"progressive\": true (its passes and time_limit are then not used)")
       ->excludes("--progressive")->group(group);
-  c->add_option("--passes", a.passes, "--progressive: stop once this many passes are done")
+  c->add_option("--passes", a.passes, "--progressive: stop once this many passes are done (an animation: per frame)")
       ->check(rangeOf(scene::limits::kPasses))->group(group);
   c->add_option("--time-limit", a.timeLimit,
                 "--progressive: stop after the pass that reaches this many seconds (under mpirun: after the round of "
-                "passes that reaches it)")
+                "passes that reaches it; an animation: per frame)")
       ->check(rangeOf(scene::limits::kTimeLimit))->group(group);
   c->add_option("--alpha", a.alpha,
                 "--progressive: the kernel's shrink per pass, volume_{i+1} = volume_i (i + alpha)/(i + 1), in (0, 1) "

@@ -485,10 +485,16 @@ void loadRenderSetup(const RenderArgs& a, dist::Comm& comm, bool framePattern, R
 ProgressiveState startProgressiveState(const RenderArgs& a, const RenderSetup& s, dist::Comm& comm) {
   ProgressiveState state;
   if (!s.opt.progressive) return state;
-  // Not yet run per frame (every rank sees the same scene: an agreed error).
-  if (s.desc.animation)
-    throw dist::AgreedError("--progressive: an animation's frames are rendered with a fixed photon budget; progressive frames are "
-                "not supported yet (leave out --progressive, or render.progressive in " + a.scene + ")");
+  // An animation's progressive frames each start from an empty state
+  // (render/animation.h); a frame's state is not kept, so nothing can be
+  // resumed (every rank sees the same flags: an agreed error).
+  if (s.desc.animation) {
+    if (a.resume)
+      throw dist::AgreedError("--resume " + *a.resume + ": " + a.scene +
+                              " is an animation, and its progressive frames cannot be resumed (each frame's passes "
+                              "start afresh; render the frames again, with more --passes)");
+    return state;
+  }
   // Under mpirun rank 0 alone reads --resume and holds the state; the
   // pass loop sends the others what they need (render/progressive.h).
   std::string resumeError;

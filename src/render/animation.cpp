@@ -17,6 +17,7 @@
 #include "photon/tracer.h"
 #include "render/memory_budget.h"
 #include "render/photon_map.h"
+#include "render/progressive.h"
 
 namespace tdpm {
 
@@ -98,6 +99,45 @@ std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments,
   return map;
 }
 
+// --progressive: each frame is a progressive render of its own (the pass
+// loop of render/progressive.h, a fresh state per frame: --passes and
+// --time-limit are per frame), every pass's photons traced over the frame's
+// shutter and its camera samples taken in it (RenderOptions::frameOpen /
+// frameClose). No pads: the fixed kernel clips its time window to the
+// photons' range, so it needs no photons beyond the shutter.
+AnimationStats renderProgressiveFrames(const Scene& scene, const scene::AnimationDesc& anim, const RenderOptions& opt,
+                                       const AnimationOptions& ao, const Progress& progress, const FrameSink& sink) {
+  AnimationStats stats;
+  const size_t total = size_t(ao.last - ao.first + 1);
+  progress.at(WorkPosition{"frame", 0, total, 0, 0});
+  uint64_t emitted = 0;
+  for (int i = ao.first; i <= ao.last; ++i) {
+    const std::string prefix =
+        "frame " + std::to_string(i) + " (" + std::to_string(i - ao.first + 1) + "/" + std::to_string(total) + "): ";
+    Progress framed;  // stages prefixed by the frame; the pass positions stay the frame loop's
+    framed.report = [&](const std::string& stage, size_t done, size_t all) { progress(prefix + stage, done, all); };
+    RenderOptions frameOpt = opt;
+    const Shutter sh = frameShutter(anim, i);
+    frameOpt.frameOpen = sh.open;
+    frameOpt.frameClose = sh.close;
+    ProgressiveState state;
+    RenderStats st;
+    Film film = renderProgressive(scene, frameOpt, state, framed, st);
+    for (const std::string& w : st.warnings)
+      if (std::find(stats.warnings.begin(), stats.warnings.end(), w) == stats.warnings.end()) stats.warnings.push_back(w);
+    stats.photonSeconds += st.photonSeconds;
+    stats.causticStored += st.causticStored;
+    stats.globalStored += st.globalStored;
+    stats.causticEmitted += st.causticEmitted;
+    stats.globalEmitted += st.globalEmitted;
+    emitted += st.causticEmitted + st.globalEmitted;
+    stats.passesDone += uint64_t(state.passesDone);
+    sink(i, std::move(film), st);
+    progress.at(WorkPosition{"frame", size_t(i - ao.first + 1), total, 0, emitted});
+  }
+  return stats;
+}
+
 }  // namespace
 
 Shutter frameShutter(const scene::AnimationDesc& a, int frame) {
@@ -145,12 +185,194 @@ TimeGrid makeTimeGrid(const scene::AnimationDesc& a, double reach) {
   return best;
 }
 
+namespace {
+
+void addWarning(AnimationStats& stats, const std::string& w) {
+  if (!w.empty() && std::find(stats.warnings.begin(), stats.warnings.end(), w) == stats.warnings.end())
+    stats.warnings.push_back(w);
+}
+
+// Memory: the window's segments (each frame's shutter and pads) and one
+// frame's two copies of its maps, at --photons per shutter.
+void checkAnimationMemory(const Scene& scene, const RenderOptions& opt, const TimeGrid& grid, int window,
+                          int windowFlag, bool photons, bool wantGlobal) {
+  if (!photons) {
+    checkMemoryBudget(scene, opt, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
+    return;
+  }
+  RenderOptions held = opt;
+  double factor = double(window + 2) * double(grid.shutterBins + 2 * grid.padBins) / double(grid.shutterBins) + 1.0;
+  held.causticPhotons = size_t(double(opt.causticPhotons) * factor);
+  held.globalPhotons = wantGlobal ? size_t(double(opt.globalPhotons) * factor) : 0;
+  // The budget's message names what multiplied the scene's counts.
+  const std::string times = " per frame, held for a window of " + std::to_string(window) +
+                            " frames at once (--window " + std::to_string(windowFlag) + ")";
+  held.causticPhotonsSource = opt.causticPhotonsSource + " (" + std::to_string(opt.causticPhotons) + times + ")";
+  held.globalPhotonsSource = opt.globalPhotonsSource + " (" + std::to_string(opt.globalPhotons) + times + ")";
+  checkMemoryBudget(scene, held, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
+}
+
+// The fixed-budget frame loop's photon side: the segments of the timeline,
+// traced when a window of frames first needs them and held until no later
+// frame of the run does, and the pilot rates that size their emission.
+class SegmentTimeline {
+ public:
+  SegmentTimeline(const Scene& scene, const scene::AnimationDesc& anim, const RenderOptions& opt,
+                  const AnimationOptions& ao, const TimeGrid& grid, std::vector<Kind> kinds, const Progress& framed,
+                  AnimationStats& stats)
+      : scene_(scene), anim_(anim), opt_(opt), ao_(ao), grid_(grid), kinds_(std::move(kinds)), framed_(framed),
+        stats_(stats), cuts_(cutPoints(grid, anim.frames, ao.first, ao.last)) {}
+
+  // Trace the segments frames [w0, w1] need that are not held yet.
+  void traceWindow(int w0, int w1) {
+    for (size_t k = 0; k + 1 < cuts_.size(); ++k) {
+      int64_t lo = cuts_[k], hi = cuts_[k + 1];
+      if (hi <= grid_.mapLo(w0) || lo >= grid_.mapHi(w1) || held_.count(lo)) continue;
+      bool used = false;
+      for (int i = w0; i <= w1 && !used; ++i) used = inside(lo, hi, grid_.mapLo(i), grid_.mapHi(i));
+      if (!used) continue;
+      held_.emplace(lo, traceSegment(lo, hi));
+      ++stats_.segmentsTraced;
+    }
+  }
+
+  // Free what no frame after `frame` needs.
+  void releaseBefore(int frame) {
+    for (auto it = held_.begin(); it != held_.end();)
+      it = it->second.hi <= grid_.mapLo(frame) ? held_.erase(it) : std::next(it);
+  }
+
+  std::vector<const Segment*> segments() const {
+    std::vector<const Segment*> segs;
+    for (const auto& [lo, s] : held_) segs.push_back(&s);
+    return segs;
+  }
+  size_t heldPhotons() const {
+    size_t n = 0;
+    for (const auto& [lo, s] : held_) n += s.size();
+    return n;
+  }
+  uint64_t emitted() const { return emitted_; }
+
+ private:
+  // Pilot: stored photons per path, once per frame period and kind, over
+  // that frame's time map (the caustic map aims at where the specular
+  // objects are then). Segments of the period size their emission by it,
+  // so a frame's photons do not depend on the range or window of the run.
+  double rateFor(int64_t period, const Kind& kd) {
+    auto key = std::pair{period, int(kd.kind)};
+    auto it = rates_.find(key);
+    if (it != rates_.end()) return it->second;
+    const int64_t timelineEnd = int64_t(anim_.frames) * grid_.binsPerFrame;
+    photon::TraceSettings ts;
+    ts.kind = kd.kind;
+    ts.storedWanted = 1;
+    ts.seed = hashCombine(opt_.seed, 0x9170ull, uint64_t(period));
+    ts.maxBounces = opt_.maxDepth;
+    ts.sampler = opt_.sampler;
+    int frame = int(std::clamp<int64_t>(period, 0, anim_.frames - 1));
+    ts.timeOpen = float(double(std::max<int64_t>(0, grid_.mapLo(frame))) * grid_.binWidth);
+    ts.timeClose = float(double(std::min(timelineEnd, grid_.mapHi(frame))) * grid_.binWidth);
+    photon::TraceResult r = photon::tracePhotons(scene_, ts, Progress{});
+    addWarning(stats_, r.warning);
+    return rates_[key] = r.storedPerPath;
+  }
+
+  Segment traceSegment(int64_t lo, int64_t hi) {
+    Segment seg;
+    seg.lo = lo;
+    seg.hi = hi;
+    // Seeded by the segment's place in its frame period, not by the
+    // frame: corresponding paths of every frame use the same random
+    // numbers, so still light on still geometry does not flicker
+    // (--independent-frames: by the segment's absolute place instead).
+    int64_t phase = lo % grid_.binsPerFrame;
+    uint64_t key = ao_.independentFrames ? uint64_t(lo) | (uint64_t(1) << 62) : uint64_t(phase);
+    const int64_t period = std::clamp<int64_t>((lo + grid_.padBins) / grid_.binsPerFrame, 0, anim_.frames - 1);
+    for (const Kind& kd : kinds_) {
+      if (kd.perShutter == 0) continue;
+      double rate = rateFor(period, kd);
+      if (!(rate > 0)) continue;
+      photon::TraceSettings ts;
+      ts.kind = kd.kind;
+      double share = double(hi - lo) / (double(grid_.binsPerFrame) * anim_.shutterAngle / 360.0);
+      ts.storedWanted = size_t(std::max(1.0, std::round(double(kd.perShutter) * share)));
+      ts.seed = hashCombine(opt_.seed, key, uint64_t(hi - lo));
+      ts.maxBounces = opt_.maxDepth;
+      ts.sampler = opt_.sampler;
+      ts.timeOpen = float(double(lo) * grid_.binWidth);
+      ts.timeClose = float(double(hi) * grid_.binWidth);
+      ts.storeT0 = ts.timeOpen;
+      ts.storeT1 = float(double(lo + photon::kTimeBins) * grid_.binWidth);
+      ts.storedPerPath = rate;
+      photon::TraceResult r = photon::tracePhotons(scene_, ts, framed_);
+      addWarning(stats_, r.warning);
+      emitted_ += r.emitted;
+      bool c = kd.kind == photon::MapKind::Caustic;
+      (c ? stats_.causticStored : stats_.globalStored) += r.store.size();
+      (c ? stats_.causticEmitted : stats_.globalEmitted) += r.emitted;
+      (c ? seg.caustic : seg.global) = std::move(r.store);
+    }
+    return seg;
+  }
+
+  const Scene& scene_;
+  const scene::AnimationDesc& anim_;
+  const RenderOptions& opt_;
+  const AnimationOptions& ao_;
+  const TimeGrid& grid_;
+  const std::vector<Kind> kinds_;
+  const Progress& framed_;
+  AnimationStats& stats_;
+  const std::vector<int64_t> cuts_;
+  std::map<std::pair<int64_t, int>, double> rates_;
+  std::map<int64_t, Segment> held_;  // by lo
+  uint64_t emitted_ = 0;
+};
+
+// One fixed-budget frame: its maps from the held segments, renderFrame, the
+// sink. The maps are freed before the sink writes the frame.
+void renderTimelineFrame(const Scene& scene, const scene::AnimationDesc& anim, const RenderOptions& opt,
+                         const TimeGrid& grid, int frame, bool photons, bool spaceTime, const SegmentTimeline& timeline,
+                         const Progress& framed, AnimationStats& stats, const FrameSink& sink) {
+  FrameInput in;
+  in.shutter = frameShutter(anim, frame);
+  std::unique_ptr<PhotonMap> caustic, global;
+  size_t heldNow = timeline.heldPhotons();
+  if (photons) {
+    Timer mapTimer;
+    std::vector<const Segment*> segs = timeline.segments();
+    caustic = frameMap(segs, true, grid, frame, spaceTime, opt.kappa);
+    global = frameMap(segs, false, grid, frame, spaceTime, opt.kappa);
+    in.caustic = caustic.get();
+    in.global = global.get();
+    heldNow += caustic->store.size() + caustic->store3.size() + global->store.size() + global->store3.size();
+    stats.photonSeconds += mapTimer.seconds();
+  }
+  stats.peakHeldPhotons = std::max(stats.peakHeldPhotons, heldNow);
+  RenderStats st;
+  Film film = renderFrame(scene, opt, in, framed, st);
+  if (photons) {
+    st.causticStored = caustic->store3.size();  // the frame's own shutter
+    st.globalStored = global->store3.size();
+  }
+  caustic.reset();
+  global.reset();
+  sink(frame, std::move(film), st);
+}
+
+}  // namespace
+
+// One level: the checks, the grid and the memory budget, then windows of
+// frames: trace what the window needs, render its frames, free what no
+// later frame needs.
 AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& anim, const RenderOptions& opt,
                                const AnimationOptions& ao, const Progress& progress, const FrameSink& sink) {
   const RenderMethodTraits& method = renderMethodTraits(opt.method);
   if (!method.animation)
     throw Error("method '" + std::string(method.name) + "' cannot render an animation (use time, standard or pathtrace)");
   TDPM_ASSERT(ao.first >= 0 && ao.last < anim.frames && ao.first <= ao.last && ao.window >= 1, "bad frame range");
+  if (opt.progressive) return renderProgressiveFrames(scene, anim, opt, ao, progress, sink);
   AnimationStats stats;
   const double shutter = anim.shutterLength();
   const double reach = std::isfinite(opt.estimate.maxTimeDistance) ? opt.estimate.maxTimeDistance / shutter
@@ -165,147 +387,31 @@ AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& a
   // photons). Frames' photons do not depend on the window, so capping it
   // changes no image.
   const int window = int(std::min<int64_t>(ao.window, int64_t(total)));
-
-  // Memory: the window's segments (each frame's shutter and pads) and one
-  // frame's two copies of its maps, at --photons per shutter.
-  if (photons) {
-    RenderOptions held = opt;
-    double factor = double(window + 2) * double(grid.shutterBins + 2 * grid.padBins) / double(grid.shutterBins) + 1.0;
-    held.causticPhotons = size_t(double(opt.causticPhotons) * factor);
-    held.globalPhotons = wantGlobal ? size_t(double(opt.globalPhotons) * factor) : 0;
-    // The budget's message names what multiplied the scene's counts.
-    const std::string times = " per frame, held for a window of " + std::to_string(window) +
-                              " frames at once (--window " + std::to_string(ao.window) + ")";
-    held.causticPhotonsSource = opt.causticPhotonsSource + " (" + std::to_string(opt.causticPhotons) + times + ")";
-    held.globalPhotonsSource = opt.globalPhotonsSource + " (" + std::to_string(opt.globalPhotons) + times + ")";
-    checkMemoryBudget(scene, held, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
-  } else {
-    checkMemoryBudget(scene, opt, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
-  }
+  checkAnimationMemory(scene, opt, grid, window, ao.window, photons, wantGlobal);
 
   std::string prefix;
   Progress framed;
   framed.report = [&](const std::string& stage, size_t done, size_t all) { progress(prefix + stage, done, all); };
   framed.position = progress.position;
-
   std::vector<Kind> kinds;
   if (photons)
     for (auto [kind, count] : {std::pair{photon::MapKind::Caustic, opt.causticPhotons},
                                std::pair{photon::MapKind::Global, wantGlobal ? opt.globalPhotons : size_t(0)}})
       kinds.push_back(Kind{kind, count});
-  // Pilot: stored photons per path, once per frame period and kind, over
-  // that frame's time map (the caustic map aims at where the specular
-  // objects are then). Segments of the period size their emission by it,
-  // so a frame's photons do not depend on the range or window of the run.
-  const int64_t timelineEnd = int64_t(anim.frames) * grid.binsPerFrame;
-  std::map<std::pair<int64_t, int>, double> rates;
-  auto rateFor = [&](int64_t period, const Kind& kd) {
-    auto key = std::pair{period, int(kd.kind)};
-    auto it = rates.find(key);
-    if (it != rates.end()) return it->second;
-    photon::TraceSettings ts;
-    ts.kind = kd.kind;
-    ts.storedWanted = 1;
-    ts.seed = hashCombine(opt.seed, 0x9170ull, uint64_t(period));
-    ts.maxBounces = opt.maxDepth;
-    ts.sampler = opt.sampler;
-    int frame = int(std::clamp<int64_t>(period, 0, anim.frames - 1));
-    ts.timeOpen = float(double(std::max<int64_t>(0, grid.mapLo(frame))) * grid.binWidth);
-    ts.timeClose = float(double(std::min(timelineEnd, grid.mapHi(frame))) * grid.binWidth);
-    photon::TraceResult r = photon::tracePhotons(scene, ts, Progress{});
-    if (!r.warning.empty() && std::find(stats.warnings.begin(), stats.warnings.end(), r.warning) == stats.warnings.end())
-      stats.warnings.push_back(r.warning);
-    return rates[key] = r.storedPerPath;
-  };
+  SegmentTimeline timeline(scene, anim, opt, ao, grid, std::move(kinds), framed, stats);
 
-  const std::vector<int64_t> cuts = cutPoints(grid, anim.frames, ao.first, ao.last);
-  std::map<int64_t, Segment> held;  // by lo
-  uint64_t emitted = 0;
   progress.at(WorkPosition{"frame", 0, total, 0, 0});
   for (int w0 = ao.first; w0 <= ao.last; w0 += window) {
     const int w1 = std::min(ao.last, w0 + window - 1);
-    // Trace the segments this window's frames need that are not held yet.
     Timer traceTimer;
-    if (photons)
-      for (size_t k = 0; k + 1 < cuts.size(); ++k) {
-        int64_t lo = cuts[k], hi = cuts[k + 1];
-        if (hi <= grid.mapLo(w0) || lo >= grid.mapHi(w1) || held.count(lo)) continue;
-        bool used = false;
-        for (int i = w0; i <= w1 && !used; ++i) used = inside(lo, hi, grid.mapLo(i), grid.mapHi(i));
-        if (!used) continue;
-        Segment seg;
-        seg.lo = lo;
-        seg.hi = hi;
-        // Seeded by the segment's place in its frame period, not by the
-        // frame: corresponding paths of every frame use the same random
-        // numbers, so still light on still geometry does not flicker
-        // (--independent-frames: by the segment's absolute place instead).
-        int64_t phase = lo % grid.binsPerFrame;
-        uint64_t key = ao.independentFrames ? uint64_t(lo) | (uint64_t(1) << 62) : uint64_t(phase);
-        const int64_t period = std::clamp<int64_t>((lo + grid.padBins) / grid.binsPerFrame, 0, anim.frames - 1);
-        for (const Kind& kd : kinds) {
-          if (kd.perShutter == 0) continue;
-          double rate = rateFor(period, kd);
-          if (!(rate > 0)) continue;
-          photon::TraceSettings ts;
-          ts.kind = kd.kind;
-          double share = double(hi - lo) / (double(grid.binsPerFrame) * anim.shutterAngle / 360.0);
-          ts.storedWanted = size_t(std::max(1.0, std::round(double(kd.perShutter) * share)));
-          ts.seed = hashCombine(opt.seed, key, uint64_t(hi - lo));
-          ts.maxBounces = opt.maxDepth;
-          ts.sampler = opt.sampler;
-          ts.timeOpen = float(double(lo) * grid.binWidth);
-          ts.timeClose = float(double(hi) * grid.binWidth);
-          ts.storeT0 = ts.timeOpen;
-          ts.storeT1 = float(double(lo + photon::kTimeBins) * grid.binWidth);
-          ts.storedPerPath = rate;
-          photon::TraceResult r = photon::tracePhotons(scene, ts, framed);
-          if (!r.warning.empty() && std::find(stats.warnings.begin(), stats.warnings.end(), r.warning) == stats.warnings.end())
-            stats.warnings.push_back(r.warning);
-          emitted += r.emitted;
-          bool c = kd.kind == photon::MapKind::Caustic;
-          (c ? stats.causticStored : stats.globalStored) += r.store.size();
-          (c ? stats.causticEmitted : stats.globalEmitted) += r.emitted;
-          (c ? seg.caustic : seg.global) = std::move(r.store);
-        }
-        ++stats.segmentsTraced;
-        held.emplace(lo, std::move(seg));
-      }
+    if (photons) timeline.traceWindow(w0, w1);
     stats.photonSeconds += traceTimer.seconds();
-
     for (int i = w0; i <= w1; ++i) {
       prefix = "frame " + std::to_string(i) + " (" + std::to_string(i - ao.first + 1) + "/" + std::to_string(total) + "): ";
-      FrameInput in;
-      in.shutter = frameShutter(anim, i);
-      std::unique_ptr<PhotonMap> caustic, global;
-      size_t heldNow = 0;
-      for (const auto& [lo, s] : held) heldNow += s.size();
-      if (photons) {
-        Timer mapTimer;
-        std::vector<const Segment*> segs;
-        for (const auto& [lo, s] : held) segs.push_back(&s);
-        caustic = frameMap(segs, true, grid, i, spaceTime, opt.kappa);
-        global = frameMap(segs, false, grid, i, spaceTime, opt.kappa);
-        in.caustic = caustic.get();
-        in.global = global.get();
-        heldNow += caustic->store.size() + caustic->store3.size() + global->store.size() + global->store3.size();
-        stats.photonSeconds += mapTimer.seconds();
-      }
-      stats.peakHeldPhotons = std::max(stats.peakHeldPhotons, heldNow);
-      RenderStats st;
-      Film film = renderFrame(scene, opt, in, framed, st);
-      if (photons) {
-        st.causticStored = caustic->store3.size();  // the frame's own shutter
-        st.globalStored = global->store3.size();
-      }
-      caustic.reset();
-      global.reset();
-      sink(i, std::move(film), st);
-      progress.at(WorkPosition{"frame", size_t(i - ao.first + 1), total, 0, emitted});
+      renderTimelineFrame(scene, anim, opt, grid, i, photons, spaceTime, timeline, framed, stats, sink);
+      progress.at(WorkPosition{"frame", size_t(i - ao.first + 1), total, 0, timeline.emitted()});
     }
-    // Free what no later frame of this run needs.
-    for (auto it = held.begin(); it != held.end();)
-      it = it->second.hi <= grid.mapLo(w1 + 1) ? held.erase(it) : std::next(it);
+    timeline.releaseBefore(w1 + 1);
   }
   return stats;
 }

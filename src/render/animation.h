@@ -55,6 +55,7 @@ struct AnimationStats {
   double photonSeconds = 0;                   // tracing, and building frame maps
   uint64_t causticStored = 0, globalStored = 0, causticEmitted = 0, globalEmitted = 0;
   uint64_t segmentsTraced = 0;
+  uint64_t passesDone = 0;                    // --progressive: passes of all frames (no segments are traced)
   size_t peakHeldPhotons = 0;                 // segments + the frame's maps, at most
   std::vector<std::string> warnings;
 };
@@ -66,6 +67,9 @@ using FrameSink = std::function<void(int frame, Film&& film, const RenderStats& 
 // Renders options.first..options.last. Methods: time, standard, pathtrace
 // (others are refused with an Error). `--photons` counts are per frame's
 // shutter time. Reports progress.at(WorkPosition{"frame", ...}).
+// options.progressive: each frame is a progressive render (time, standard;
+// --passes / --time-limit per frame), its passes' photons and camera samples
+// in the frame's shutter; the window and segments are not used.
 AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& animation, const RenderOptions& options,
                                const AnimationOptions& animationOptions, const Progress& progress,
                                const FrameSink& sink);

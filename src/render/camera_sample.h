@@ -12,9 +12,11 @@
 // lens, so a pinhole render draws what it always drew). The pixel filter is importance sampled (sampling/filter.h), so every sample's
 // filter weight is 1 and nothing is multiplied.
 #pragma once
+#include <cmath>
 #include <cstdint>
 
 #include "math/vec.h"
+#include "motion/shutter.h"
 #include "sampling/filter.h"
 #include "sampling/stratified.h"
 #include "scene/camera.h"
@@ -36,6 +38,15 @@ struct SampleTimes {
     return lo01 + u * (hi01 - lo01);
   }
 };
+
+// An animation frame's part of the timeline [open, close] (scene seconds)
+// into `t`; a NaN open leaves the whole shutter. The fixed-budget frame
+// (renderFrame) and the progressive frame's passes both map it here.
+inline void setFrameTimes(SampleTimes& t, const Shutter& sceneShutter, float open, float close) {
+  if (!std::isfinite(open)) return;
+  t.lo01 = sceneShutter.normalized(open);
+  t.hi01 = sceneShutter.normalized(close);
+}
 
 // What every camera sample of a render shares.
 struct CameraSamplePlan {

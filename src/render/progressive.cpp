@@ -48,7 +48,10 @@ float maxRadiusOf(const Scene& scene, const RenderOptions& opt) {
   return opt.maxRadiusFraction * diag;
 }
 
-double shutterOf(const Scene& scene) {
+// The time the passes' photons span: the scene's shutter, or an animation
+// frame's (RenderOptions::frameOpen/frameClose).
+double shutterOf(const Scene& scene, const RenderOptions& opt) {
+  if (std::isfinite(opt.frameOpen)) return double(opt.frameClose) - double(opt.frameOpen);
   float t0, t1;
   photon::photonTimeRange(scene, t0, t1);
   return double(t1) - double(t0);
@@ -76,7 +79,7 @@ double median(std::vector<double>& v) {
 estimate::MapKernel pilotKernel(const PhotonMap* map, const Scene& scene, const RenderOptions& opt, bool spaceTime) {
   estimate::MapKernel k;
   float maxR = maxRadiusOf(scene, opt);
-  double ts = shutterOf(scene);
+  double ts = shutterOf(scene, opt);
   double maxDt = std::isfinite(opt.estimate.maxTimeDistance) ? double(opt.estimate.maxTimeDistance)
                                                               : double(opt.maxDtFraction) * ts;
   k.radius = k.spatialRadius = maxR;
@@ -161,6 +164,7 @@ void renderPassPixels(const Scene& scene, const PhotonIntegrator& integ, const R
   CameraSamplePlan plan{pixelFilterFor(opt), {}};
   plan.times.fixed01 = fixedTime01;
   plan.times.moving = scene.hasMotion;
+  setFrameTimes(plan.times, scene.shutter, opt.frameOpen, opt.frameClose);
   forEachTile<Scratch<PhotonIntegrator>>(w, h, stage, progress, [&](const Tile& t, Scratch<PhotonIntegrator>& s) {
     // The pixel in flight: its count m, its first index, and its sums (all
     // samples full when m == spp; else eye and rest apart).
@@ -304,6 +308,10 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
   //      passes trace the same number of paths at the next path indices ----
   auto trace = [&](photon::MapKind kind, size_t wanted, const char* key) -> std::unique_ptr<PhotonMap> {
     PhotonMapSettings ms = photonMapSettingsFor(opt, kind, wanted, opt.seed, spread, passTime >= 0 ? passTime : 0.0f);
+    if (std::isfinite(opt.frameOpen)) {  // an animation frame: its shutter alone (the fixed kernel clips its window to it)
+      ms.trace.timeOpen = opt.frameOpen;
+      ms.trace.timeClose = opt.frameClose;
+    }
     auto it = state.scalars.find(key);
     if (it != state.scalars.end()) {
       // A resumed value was checked (render/progressive_check.h): a whole
@@ -452,7 +460,7 @@ float accumulationPassTime(int pass, uint64_t seed) {
 PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& opt, const Scene& scene, int pass) {
   const bool time = renderMethodTraits(opt.method).timeDependentEstimate;  // has a space-time kernel
   const double alpha = mainAlpha(opt);
-  const double binWidth = shutterOf(scene) / photon::kTimeBins;
+  const double binWidth = shutterOf(scene, opt) / photon::kTimeBins;
   // time: the space-time kernel (d = 3) takes the main alpha, its spatial
   // fallback 2/3; the other variants have only the spatial kernel (d = 2).
   const double s3 = kernelScale(pass, alpha, 3);

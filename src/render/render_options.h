@@ -6,6 +6,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -73,6 +74,12 @@ struct RenderOptions {
   int passes = 0;                 // stop once this many passes are done in all (0: the time limit decides)
   double timeLimitSeconds = 0;    // > 0: stop after the pass that reaches it (this run's seconds)
   float alpha = 0;                // > 0: overrides the variant's alpha (docs/photon-map.md)
+  // An animation frame rendered in passes (render/animation.h): the frame's
+  // shutter in scene seconds. Every pass traces its photons over it and
+  // takes its camera samples in it (the scene's shutter is the whole
+  // timeline). NaN: the scene's shutter.
+  float frameOpen = std::numeric_limits<float>::quiet_NaN();
+  float frameClose = std::numeric_limits<float>::quiet_NaN();
   // Eye samples where the eye paths are noisy (render/sample_allocation.h):
   // every pass gives pixel p m_p in [spp, passSampleCap x spp] samples from
   // an eye-only pilot, with at most passExtraSamples x spp x pixels above

@@ -550,8 +550,7 @@ Film renderFrame(const Scene& scene, const RenderOptions& opt, const FrameInput&
   st = RenderStats{};
   Film film(scene.camera.width(), scene.camera.height());
   SamplingPlan plan = samplingPlanFor(opt);
-  plan.camera.times.lo01 = scene.shutter.normalized(frame.shutter.open);
-  plan.camera.times.hi01 = scene.shutter.normalized(frame.shutter.close);
+  setFrameTimes(plan.camera.times, scene.shutter, frame.shutter.open, frame.shutter.close);
   if (!renderMethodTraits(opt.method).photonMaps) {
     renderPathTraced(scene, opt, plan, progress, st, film);
   } else {

@@ -93,6 +93,7 @@ std::vector<float> pilotNoise(const Scene& scene, const RenderOptions& opt, cons
   PhotonIntegrator eyeOnly(scene, nullptr, nullptr, is);
   CameraSamplePlan plan{pixelFilterFor(opt), {}};
   plan.times.moving = scene.hasMotion;
+  setFrameTimes(plan.times, scene.shutter, opt.frameOpen, opt.frameClose);  // an animation frame's passes
   const uint64_t seed = hashCombine(opt.seed, kPilotSeedSalt);
   std::vector<float> mean(n, 0.0f), var(n, 0.0f);
   forEachTile<PilotScratch>(w, h, "pilot", progress, [&](const Tile& t, PilotScratch& s) {
