@@ -24,6 +24,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/signals.h"
+#include "core/temp_dir.h"
 #include "core/memory.h"
 #include "core/timer.h"
 #include "image/png.h"
@@ -93,12 +94,8 @@ void assembleVideo(const std::string& ffmpeg, const std::string& video, const st
   // only then, when this deferral ends, does the signal end tdpm (it used
   // to leave the folder and a running ffmpeg; issue 27 item 13).
   signals::Deferral untilCleanedUp;
-  std::string tmpl = directoryOf(video) + "/.tdpm-video-XXXXXX";
-  std::vector<char> buf(tmpl.begin(), tmpl.end());
-  buf.push_back('\0');
-  if (!mkdtemp(buf.data())) throw Error("--video: cannot create a temporary directory beside '" + video + "' (" +
-                                        std::strerror(errno) + ")");
-  std::string tmp(buf.data());
+  // ".tdpm-video-<pid>-XXXXXX": a later run removes those of dead (SIGKILLed) runs.
+  std::string tmp = makeWorkFolder(directoryOf(video), ".tdpm-video-", "--video");
   struct Cleanup {
     std::string dir;
     ~Cleanup() {
