@@ -216,12 +216,13 @@ CLI::App* addCompareCommand(CLI::App& app, CompareArgs& a) {
   return c;
 }
 
-int runCompare(const CompareArgs& a) {
-  // Outputs first: a wrong path must not cost reading two large EXRs, and
-  // nothing is written unless everything below succeeds.
+namespace {
+
+// Outputs first: a wrong path must not cost reading two large EXRs. By
+// file identity (st_dev/st_ino), not by name: a link to an input, or another
+// spelling of its path, would overwrite it just the same.
+void checkCompareOutputs(const CompareArgs& a) {
   if (a.plot && !endsWith(*a.plot, ".svg")) throw Error("--plot: '" + *a.plot + "' must end in .svg (it is an SVG file)");
-  // By file identity (st_dev/st_ino), not by name: a link to an input, or
-  // another spelling of its path, would overwrite it just the same.
   auto same = [](const std::string& x, const std::string& y) { return x == y || sameFile(x, y); };
   if (a.csv && a.plot && same(*a.csv, *a.plot)) throw Error("--csv and --plot name the same file '" + *a.csv + "'");
   for (const auto& [flag, out] : {std::pair{"--csv", a.csv}, std::pair{"--plot", a.plot}}) {
@@ -232,100 +233,113 @@ int runCompare(const CompareArgs& a) {
                     (*out == *in ? "" : " (the same file)") + "; refusing to overwrite it");
     checkWritable(flag, *out);
   }
+}
 
-  // Sizes from the headers before either image is decoded (a small PNG can
-  // claim 20000x20000). A header too damaged to tell is left to the reader.
-  std::optional<image::ImageHeader> testHeader, refHeader;
+// `read(path)` with the image's role in front of the reader's error (which
+// already names the file).
+template <class Read>
+auto readAs(const char* role, const std::string& path, Read read) {
   try {
-    testHeader = image::readImageHeader(a.test);
+    return read(path);
   } catch (const Error& e) {
-    throw Error(std::string("test image: ") + e.what());
+    throw Error(std::string(role) + ": " + e.what());
   }
-  try {
-    refHeader = image::readImageHeader(a.reference);
-  } catch (const Error& e) {
-    throw Error(std::string("reference image: ") + e.what());
-  }
-  if (testHeader && refHeader && (testHeader->width != refHeader->width || testHeader->height != refHeader->height))
-    throw Error("image sizes differ: " + a.test + " is " + std::to_string(testHeader->width) + "x" +
-                std::to_string(testHeader->height) + " but " + a.reference + " is " + std::to_string(refHeader->width) + "x" +
-                std::to_string(refHeader->height) + " (compare needs two images of the same size; read from their headers)");
+}
 
-  // The readers' errors already name the file ("<path>: ..."); say which role.
-  image::LoadedImage test, ref;
-  try {
-    test = image::readImage(a.test);
-  } catch (const Error& e) {
-    throw Error(std::string("test image: ") + e.what());
-  }
-  try {
-    ref = image::readImage(a.reference);
-  } catch (const Error& e) {
-    throw Error(std::string("reference image: ") + e.what());
-  }
+// Both images, sizes compared from their headers before either is decoded
+// (a small PNG can claim 20000x20000; a header too damaged to tell is left
+// to the reader), and again after decoding.
+void readComparedImages(const CompareArgs& a, image::LoadedImage& test, image::LoadedImage& ref) {
+  std::optional<image::ImageHeader> th = readAs("test image", a.test, image::readImageHeader);
+  std::optional<image::ImageHeader> rh = readAs("reference image", a.reference, image::readImageHeader);
+  if (th && rh && (th->width != rh->width || th->height != rh->height))
+    throw Error("image sizes differ: " + a.test + " is " + std::to_string(th->width) + "x" + std::to_string(th->height) +
+                " but " + a.reference + " is " + std::to_string(rh->width) + "x" + std::to_string(rh->height) +
+                " (compare needs two images of the same size; read from their headers)");
+  test = readAs("test image", a.test, image::readImage);
+  ref = readAs("reference image", a.reference, image::readImage);
   if (test.color.width != ref.color.width || test.color.height != ref.color.height)
     throw Error("image sizes differ: " + a.test + " is " + sizeText(test.color) + " but " + a.reference + " is " +
                 sizeText(ref.color) + " (compare needs two images of the same size)");
+}
 
-  std::optional<PixelRect> crop;
-  if (a.crop) {
-    PixelRect r;
-    std::string why = parseCrop(*a.crop, r);
-    if (!why.empty()) throw Error("--crop: " + why);  // CLI11 checked already; kept for direct callers
-    if (!image::cropInside(r, test.color.width, test.color.height))
-      throw Error("--crop " + *a.crop + ": the rectangle (" + rectText(r) + ") is not inside the " +
-                  sizeText(test.color) + " images (columns 0.." + std::to_string(test.color.width - 1) + ", rows 0.." +
-                  std::to_string(test.color.height - 1) + ")");
-    crop = r;
+std::optional<PixelRect> cropFor(const CompareArgs& a, const image::ImageRgb& im) {
+  if (!a.crop) return std::nullopt;
+  PixelRect r;
+  std::string why = parseCrop(*a.crop, r);
+  if (!why.empty()) throw Error("--crop: " + why);  // CLI11 checked already; kept for direct callers
+  if (!image::cropInside(r, im.width, im.height))
+    throw Error("--crop " + *a.crop + ": the rectangle (" + rectText(r) + ") is not inside the " + sizeText(im) +
+                " images (columns 0.." + std::to_string(im.width - 1) + ", rows 0.." + std::to_string(im.height - 1) +
+                ")");
+  return r;
+}
+
+// With --crop the profile covers the crop's columns, and its row must be
+// one of the crop's rows: everything reported is about that rectangle.
+std::optional<image::RowProfile> profileFor(const CompareArgs& a, const image::ImageRgb& test, const image::ImageRgb& ref,
+                                            const std::optional<PixelRect>& crop) {
+  if (!a.profileRow) return std::nullopt;
+  int y = *a.profileRow;
+  if (y < 0 || y >= test.height)
+    throw Error("--profile-row " + std::to_string(y) + ": outside the " + sizeText(test) + " images (rows 0.." +
+                std::to_string(test.height - 1) + ")");
+  if (crop && (y < crop->y || y >= crop->y + crop->h))
+    throw Error("--profile-row " + std::to_string(y) + ": outside --crop " + *a.crop + " (rows " +
+                std::to_string(crop->y) + ".." + std::to_string(crop->y + crop->h - 1) + ")");
+  return crop ? image::extractRowProfile(test, ref, y, crop->x, crop->w)
+              : image::extractRowProfile(test, ref, y, 0, test.width);
+}
+
+// NaN or Inf would count as 0: an Inf where the reference is 0 would score
+// no error. Refused unless asked for, before any output.
+void refuseNonFinite(const CompareArgs& a, const image::ImageRgb& test, const image::ImageRgb& ref, const PixelRect& region) {
+  if (a.allowNonFinite) return;
+  for (const auto& [role, path, im] :
+       {std::tuple{"test image", &a.test, &test}, std::tuple{"reference image", &a.reference, &ref}}) {
+    image::NonFiniteValues bad = image::findNonFinite(*im, region);
+    if (bad.count)
+      throw Error(std::string(role) + ": " + *path + ": " + std::to_string(bad.count) + " NaN or infinite values" +
+                  (a.crop ? " inside --crop" : "") + ", the first at pixel (" + std::to_string(bad.x) + ", " +
+                  std::to_string(bad.y) + ") channel " + "RGB"[bad.channel] +
+                  "; --allow-nonfinite measures them as 0 and reports their counts");
   }
+}
 
-  std::optional<image::RowProfile> profile;
-  if (a.profileRow) {
-    int y = *a.profileRow;
-    if (y < 0 || y >= test.color.height)
-      throw Error("--profile-row " + std::to_string(y) + ": outside the " + sizeText(test.color) + " images (rows 0.." +
-                  std::to_string(test.color.height - 1) + ")");
-    // With --crop the profile covers the crop's columns, and its row must be
-    // one of the crop's rows: everything reported is about that rectangle.
-    if (crop && (y < crop->y || y >= crop->y + crop->h))
-      throw Error("--profile-row " + std::to_string(y) + ": outside --crop " + *a.crop + " (rows " +
-                  std::to_string(crop->y) + ".." + std::to_string(crop->y + crop->h - 1) + ")");
-    profile = crop ? image::extractRowProfile(test.color, ref.color, y, crop->x, crop->w)
-                   : image::extractRowProfile(test.color, ref.color, y, 0, test.color.width);
-  }
-
-  // NaN or Inf would count as 0: an Inf where the reference is 0 would
-  // score no error. Refused unless asked for, before any output.
-  const PixelRect region = crop.value_or(PixelRect{0, 0, test.color.width, test.color.height});
-  if (!a.allowNonFinite)
-    for (const auto& [role, path, im] : {std::tuple{"test image", &a.test, &test.color},
-                                         std::tuple{"reference image", &a.reference, &ref.color}}) {
-      image::NonFiniteValues bad = image::findNonFinite(*im, region);
-      if (bad.count)
-        throw Error(std::string(role) + ": " + *path + ": " + std::to_string(bad.count) +
-                    " NaN or infinite values" + (a.crop ? " inside --crop" : "") + ", the first at pixel (" +
-                    std::to_string(bad.x) + ", " + std::to_string(bad.y) + ") channel " + "RGB"[bad.channel] +
-                    "; --allow-nonfinite measures them as 0 and reports their counts");
-    }
-
-  ImageMetrics m = image::compareImages(test.color, ref.color, crop);
-  std::optional<image::SaltMetrics> salt;
-  if (a.salt) salt = image::countSalt(test.color, ref.color, region);
-
-  // Both profile files or neither, committed together: on any failure the
-  // previous pair (if any) stays as it was.
+// Both profile files or neither, committed together: on any failure the
+// previous pair (if any) stays as it was.
+void writeProfileFiles(const CompareArgs& a, const image::RowProfile& profile) {
   std::optional<AtomicFile> csvFile, plotFile;
-  if (profile && a.csv) {
+  if (a.csv) {
     csvFile.emplace(*a.csv);
-    writeTextToTemp(*csvFile, image::profileCsv(*profile));
+    writeTextToTemp(*csvFile, image::profileCsv(profile));
   }
-  if (profile && a.plot) {
+  if (a.plot) {
     plotFile.emplace(*a.plot);
-    writeTextToTemp(*plotFile, image::profileSvg(*profile, a.test, a.reference));
+    writeTextToTemp(*plotFile, image::profileSvg(profile, a.test, a.reference));
   }
   if (csvFile && plotFile) commitTogether({&*csvFile, &*plotFile});
   else if (csvFile) csvFile->commit();
   else if (plotFile) plotFile->commit();
+}
+
+}  // namespace
+
+// One level: check the outputs, read both images, measure, write, print.
+// Nothing is written unless everything before it succeeded.
+int runCompare(const CompareArgs& a) {
+  checkCompareOutputs(a);
+  image::LoadedImage test, ref;
+  readComparedImages(a, test, ref);
+  const std::optional<PixelRect> crop = cropFor(a, test.color);
+  const std::optional<image::RowProfile> profile = profileFor(a, test.color, ref.color, crop);
+  const PixelRect region = crop.value_or(PixelRect{0, 0, test.color.width, test.color.height});
+  refuseNonFinite(a, test.color, ref.color, region);
+
+  ImageMetrics m = image::compareImages(test.color, ref.color, crop);
+  std::optional<image::SaltMetrics> salt;
+  if (a.salt) salt = image::countSalt(test.color, ref.color, region);
+  if (profile) writeProfileFiles(a, *profile);
 
   if (m.nonFiniteTest || m.nonFiniteRef)
     std::fprintf(stderr, "tdpm: warning: %zu non-finite values in %s and %zu in %s were counted as 0\n",
