@@ -148,7 +148,23 @@ TEST_CASE("work folders: the folder a SIGKILLed --video run left is removed by t
   std::ifstream pidIn(pidFile);
   int ffmpeg = 0;
   pidIn >> ffmpeg;
-  if (ffmpeg > 0) ::kill(ffmpeg, SIGKILL);  // the orphaned stand-in this test started
+  REQUIRE(ffmpeg > 0);
+  // The kernel ends ffmpeg with its parent (PR_SET_PDEATHSIG in runProcess):
+  // wait until it is gone or a zombie (no time asserted: a bounded wait).
+  auto running = [](int pid) {
+    if (::kill(pid, 0) != 0) return false;
+    std::ifstream st("/proc/" + std::to_string(pid) + "/stat");
+    std::string pidText, comm, state;
+    st >> pidText >> comm >> state;
+    return state != "Z" && state != "X";
+  };
+  bool ended = false;
+  for (int i = 0; i < 6000 && !ended; ++i) {
+    ended = !running(ffmpeg);
+    if (!ended) ::usleep(10000);
+  }
+  CHECK(ended);                          // not left orphaned
+  if (!ended) ::kill(ffmpeg, SIGKILL);  // do not leave it behind the test either
   const std::string left = ".tdpm-video-" + std::to_string(tdpm) + "-";
   std::vector<std::string> before = folderEntries(video);
   REQUIRE(before.size() == 1);  // SIGKILL cannot be caught: the folder stays, named by the dead pid

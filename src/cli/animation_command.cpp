@@ -4,6 +4,7 @@
 
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -55,9 +56,15 @@ int runProcess(const std::vector<std::string>& argv, const std::string& log) {
   for (const std::string& s : argv) args.push_back(const_cast<char*>(s.c_str()));
   args.push_back(nullptr);
   if (signals::pendingSignal()) return -1;  // tdpm is ending: no ffmpeg to start
+  const pid_t parent = getpid();
   pid_t pid = fork();
   if (pid < 0) return -1;
   if (pid == 0) {
+    // If tdpm is SIGKILLed (no handler runs), the kernel ends ffmpeg too
+    // rather than leaving it orphaned; the getppid check covers a parent
+    // that died between fork and prctl.
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(127);
     int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
     int in = open("/dev/null", O_RDONLY);
     if (fd >= 0) {
