@@ -23,6 +23,9 @@ constexpr int kRouletteStartDepth = 3;
 constexpr int kGuidedDiffuseVertices = 2;
 }
 
+// Longer than 80 lines on purpose: it is one sample's path, the render's
+// inner loop; its throughput, MIS state and running sum stay local to it
+// instead of passing through a call per vertex.
 template <class Stream>
 Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState&) const {
   Rgb L(0.0f), beta(1.0f);
