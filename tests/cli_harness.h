@@ -1,6 +1,7 @@
 // tests/cli_harness.h — runs build/tdpm as a user would (through the shell)
 // and captures its exit code and combined output; temporary directories.
 #pragma once
+#include <dirent.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -9,6 +10,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <string>
+#include <vector>
 
 namespace tdpm::test {
 
@@ -56,6 +58,30 @@ inline int countEntries(const std::string& dir) {
     pclose(p);
   }
   return n;
+}
+
+// The names in a directory (without . and ..), in readdir order.
+inline std::vector<std::string> folderEntries(const std::string& dir) {
+  std::vector<std::string> out;
+  if (DIR* d = ::opendir(dir.c_str())) {
+    while (const dirent* e = ::readdir(d)) {
+      std::string n = e->d_name;
+      if (n != "." && n != "..") out.push_back(n);
+    }
+    ::closedir(d);
+  }
+  return out;
+}
+
+// A process id that is certainly not running: a child that has exited and
+// been reaped (its pid is free until the kernel hands it out again, which
+// it does only after cycling through pid_max).
+inline pid_t deadPid() {
+  pid_t pid = ::fork();
+  if (pid == 0) ::_exit(0);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return pid;
 }
 
 }  // namespace tdpm::test

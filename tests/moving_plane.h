@@ -8,6 +8,7 @@
 
 #include "math/vec.h"
 #include "motion/shutter.h"
+#include "render/render_options.h"
 #include "scene/camera.h"
 #include "scene_fixtures.h"
 
@@ -54,6 +55,23 @@ inline double movingPlanePixel(const Camera& cam, const Shutter& shutter, int x,
         sum += kMovingPlaneRho / kPi * kMovingPlaneIntensity * (toL.y / std::sqrt(d2)) / d2;
       }
   return sum / (g * g * nt);
+}
+
+// The `time` render of a moving-plane animation frame that test_animation
+// and test_animation_progressive check: the global map seen directly (no
+// caustic map, no gather), 100k photons per frame's shutter, k = k_s = 100.
+inline RenderOptions movingPlaneFrameOptions(uint64_t seed) {
+  RenderOptions o;
+  o.method = RenderMethod::Time;
+  o.spp = 16;
+  o.seed = seed;
+  o.causticPhotons = 0;
+  o.globalPhotons = 100000;  // per frame's shutter time
+  o.visualizeGlobal = true;
+  o.estimate.k = 100;
+  o.estimate.ks = 100;
+  o.estimate.maxRadius = 1.0f;
+  return o;
 }
 
 }  // namespace tdpm::test

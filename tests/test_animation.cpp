@@ -77,19 +77,7 @@ double analyticPixel(const Camera& cam, const Shutter& sceneShutter, int x, int 
   return test::movingPlanePixel(cam, sceneShutter, x, y, t0, t1, 32);
 }
 
-RenderOptions planeOptions(uint64_t seed) {
-  RenderOptions o;
-  o.method = RenderMethod::Time;
-  o.spp = 16;
-  o.seed = seed;
-  o.causticPhotons = 0;
-  o.globalPhotons = 100000;  // per frame's shutter time
-  o.visualizeGlobal = true;
-  o.estimate.k = 100;
-  o.estimate.ks = 100;
-  o.estimate.maxRadius = 1.0f;
-  return o;
-}
+RenderOptions planeOptions(uint64_t seed) { return test::movingPlaneFrameOptions(seed); }
 
 double meanRed(const Film& f) {
   double s = 0;

@@ -34,19 +34,7 @@ scene::SceneDescription planeAnimation() {
   return d;
 }
 
-RenderOptions fixedOptions(uint64_t seed) {
-  RenderOptions o;
-  o.method = RenderMethod::Time;
-  o.spp = 16;
-  o.seed = seed;
-  o.causticPhotons = 0;
-  o.globalPhotons = 100000;  // per frame's shutter time
-  o.visualizeGlobal = true;
-  o.estimate.k = 100;
-  o.estimate.ks = 100;
-  o.estimate.maxRadius = 1.0f;
-  return o;
-}
+RenderOptions fixedOptions(uint64_t seed) { return test::movingPlaneFrameOptions(seed); }
 
 RenderOptions progressiveOptions(uint64_t seed, int passes) {
   RenderOptions o = fixedOptions(seed);

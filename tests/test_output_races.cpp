@@ -37,29 +37,7 @@ std::string readAll(const std::string& path) {
   return ss.str();
 }
 
-std::vector<std::string> entries(const std::string& dir) {
-  std::vector<std::string> out;
-  DIR* d = ::opendir(dir.c_str());
-  while (d) {
-    const dirent* e = ::readdir(d);
-    if (!e) break;
-    std::string n = e->d_name;
-    if (n != "." && n != "..") out.push_back(n);
-  }
-  if (d) ::closedir(d);
-  return out;
-}
 
-// A process id that is certainly not running: a child that has exited and
-// been reaped (its pid is free until the kernel hands it out again, which
-// it does only after cycling through pid_max).
-pid_t deadPid() {
-  pid_t pid = ::fork();
-  if (pid == 0) ::_exit(0);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return pid;
-}
 
 }  // namespace
 
@@ -142,14 +120,14 @@ TEST_CASE("output races: six writers of one pair never leave a mixed pair; a rea
   const std::string a = readAll(exr), b = readAll(png);
   CHECK(a.substr(0, 4) == "exr ");
   CHECK(a.substr(4) == b.substr(4));
-  std::vector<std::string> left = entries(dir);
+  std::vector<std::string> left = test::folderEntries(dir);
   CHECK(left.size() == 2);  // no temporary, no lock file
   std::system(("rm -rf '" + dir + "'").c_str());
 }
 
 TEST_CASE("output races: a new output removes the temporaries of dead runs for that name, and nothing else") {
   const std::string dir = test::makeTempDir();
-  const std::string dead = std::to_string(deadPid());
+  const std::string dead = std::to_string(test::deadPid());
   REQUIRE(::kill(std::stoi(dead), 0) == -1);
   // Process 1 is always running; our own pid is a live run too.
   const std::string self = std::to_string(::getpid());
@@ -212,7 +190,7 @@ TEST_CASE("output races: SIGTERM while ffmpeg makes the --video kills ffmpeg and
   const int ffmpeg = std::atoi(readAll(pidFile).c_str());
   REQUIRE(ffmpeg > 0);
   bool folder = false;
-  for (const std::string& n : entries(video)) folder = folder || n.rfind(".tdpm-video-", 0) == 0;
+  for (const std::string& n : test::folderEntries(video)) folder = folder || n.rfind(".tdpm-video-", 0) == 0;
   CHECK(folder);  // the folder the fix must remove exists while ffmpeg runs
   REQUIRE(::kill(tdpm, SIGTERM) == 0);
   // A hang guard, not a timing: the stand-in sleeps 300 s, and a tdpm that
@@ -235,6 +213,6 @@ TEST_CASE("output races: SIGTERM while ffmpeg makes the --video kills ffmpeg and
   const bool alive = ::kill(ffmpeg, 0) == 0;
   CHECK_FALSE(alive);
   if (alive) ::kill(ffmpeg, SIGKILL);  // the stand-in this test started
-  CHECK(entries(video).empty());       // no folder, no video
+  CHECK(test::folderEntries(video).empty());       // no folder, no video
   std::system(("rm -rf '" + dir + "'").c_str());
 }

@@ -23,26 +23,7 @@ using namespace tdpm;
 
 namespace {
 
-std::vector<std::string> folderEntries(const std::string& dir) {
-  std::vector<std::string> out;
-  if (DIR* d = ::opendir(dir.c_str())) {
-    while (const dirent* e = ::readdir(d)) {
-      std::string n = e->d_name;
-      if (n != "." && n != "..") out.push_back(n);
-    }
-    ::closedir(d);
-  }
-  return out;
-}
 
-// A pid that is not running: a reaped child's (free until pid_max wraps).
-pid_t reapedPid() {
-  pid_t pid = ::fork();
-  if (pid == 0) ::_exit(0);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return pid;
-}
 
 bool isDir(const std::string& p) {
   struct stat st;
@@ -57,7 +38,7 @@ bool exists(const std::string& p) {
 
 TEST_CASE("work folders: a dead run's folder is removed; live, foreign and look-alike entries stay") {
   const std::string dir = test::makeTempDir();
-  const std::string dead = std::to_string(reapedPid()), live = std::to_string(::getppid());
+  const std::string dead = std::to_string(test::deadPid()), live = std::to_string(::getppid());
   const std::string keepFile = dir + "/frame.png";
   test::writeFile(keepFile, "png");
   const std::string staleDir = dir + "/.tdpm-video-" + dead + "-aB3xY9";
@@ -166,7 +147,7 @@ TEST_CASE("work folders: the folder a SIGKILLed --video run left is removed by t
   CHECK(ended);                          // not left orphaned
   if (!ended) ::kill(ffmpeg, SIGKILL);  // do not leave it behind the test either
   const std::string left = ".tdpm-video-" + std::to_string(tdpm) + "-";
-  std::vector<std::string> before = folderEntries(video);
+  std::vector<std::string> before = test::folderEntries(video);
   REQUIRE(before.size() == 1);  // SIGKILL cannot be caught: the folder stays, named by the dead pid
   CHECK(before[0].rfind(left, 0) == 0);
 
@@ -174,7 +155,7 @@ TEST_CASE("work folders: the folder a SIGKILLed --video run left is removed by t
   const test::CommandResult r = test::runShell("PATH='" + path + "' '" + TDPM_BINARY + "' " + args + " 2>&1");
   INFO(r.output);
   CHECK(r.exitCode == 0);
-  const std::vector<std::string> after = folderEntries(video);
+  const std::vector<std::string> after = test::folderEntries(video);
   CHECK(after == std::vector<std::string>{"movie.mp4"});
   std::system(("rm -rf '" + dir + "'").c_str());
 }
