@@ -48,6 +48,7 @@ struct MaterialSlot {
   scene::MaterialDesc desc;
   int index = -1;  // in scene.materials once a shape uses it
   std::optional<Checker2D> checker;  // albedo: laid out per shape (pbrt_mapping.cpp, placeChecker)
+  int mixSlots[2] = {-1, -1};  // mix: its two materials' slots
 };
 
 struct AreaLight {

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "import/pbrt_importer.h"
 #include "import/ply_reader.h"
+#include "scene/bsdf_pbrt.h"
 #include "scene/environment.h"
 #include "scene/json_writer.h"
 #include "scene/limits.h"
@@ -105,10 +106,6 @@ std::optional<Checker2D> Importer::albedoChecker(const ParamSet& ps, const std::
   return c;
 }
 
-static float reflectanceAtNormal(double eta, double k) {
-  return float(((eta - 1) * (eta - 1) + k * k) / ((eta + 1) * (eta + 1) + k * k));
-}
-
 static void checkReflectance(const ParamSet& ps, const std::string& name, Rgb c) {
   if (c.r < 0 || c.g < 0 || c.b < 0 || c.maxComponent() > 1) {
     if (const Param* p = ps.find(name)) ps.fail(*p, "reflectance must be in [0, 1] per channel (energy conservation)");
@@ -121,14 +118,40 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
   MaterialSlot slot;
   scene::MaterialDesc& m = slot.desc;
   std::string label = name.empty() ? type : name;
-  auto roughness = [&](bool v3, double fallback, double* alpha) {
-    double u = floatParam(ps, "uroughness", floatParam(ps, "roughness", fallback));
-    double v = floatParam(ps, "vroughness", floatParam(ps, "roughness", fallback));
-    if (u != v) failAt(at, label + ": anisotropic roughness (uroughness != vroughness) is not supported");
+  // pre: the parameter prefix ("interface.", "conductor." of coatedconductor).
+  auto roughnessPre = [&](const std::string& pre, bool v3, double fallback, double* alpha) {
+    double u = floatParam(ps, pre + "uroughness", floatParam(ps, pre + "roughness", fallback));
+    double v = floatParam(ps, pre + "vroughness", floatParam(ps, pre + "roughness", fallback));
+    if (u != v)
+      failAt(at, label + ": anisotropic roughness (" + pre + "uroughness != " + pre + "vroughness) is not supported");
     bool remap = ps.getBool("remaproughness", true);
     if (u < 0) failAt(at, label + ": roughness must not be negative");
     *alpha = !remap || u == 0 ? u : (v3 ? roughnessToAlphaV3(u) : std::sqrt(u));
     if (*alpha > 1) failAt(at, label + ": roughness maps to GGX alpha " + fmtNum(*alpha) + " > 1, which tdpm does not support");
+  };
+  auto roughness = [&](bool v3, double fallback, double* alpha) { roughnessPre("", v3, fallback, alpha); };
+  // A conductor's complex IOR: pre + "eta" / "k" (pbrt's default: copper),
+  // or pbrt-v4's "reflectance" r, which is eta = 1, k = 2 sqrt(r) / sqrt(1 - r).
+  auto conductorIor = [&](bool v3, const std::string& pre, Rgb* eta, Rgb* k) {
+    if (!v3 && ps.has("reflectance")) {
+      Rgb r = color(ps, "reflectance", Rgb(1.0f));
+      checkReflectance(ps, "reflectance", r);
+      *eta = Rgb(1.0f);
+      for (int i = 0; i < 3; ++i) {
+        float ri = std::min(r[i], 0.9999f);
+        (*k)[i] = 2.0f * std::sqrt(ri) / std::sqrt(1.0f - ri);
+      }
+      return;
+    }
+    // pbrt's default is copper (pbrt_spectrum.cpp: v3 reduces its copper
+    // against equal-energy white, v4 its metal-Cu under D65).
+    bool filmV3 = v3 || (film_.given && film_.type == "image");
+    Rgb cuEta = filmV3 ? Rgb(0.200964f, 0.923779f, 1.102306f) : Rgb(0.105133f, 0.977933f, 1.204671f);
+    Rgb cuK = filmV3 ? Rgb(3.912923f, 2.453080f, 2.142269f) : Rgb(3.273486f, 2.592516f, 2.369186f);
+    *eta = color(ps, pre + "eta", cuEta);
+    *k = color(ps, pre + "k", cuK);
+    if (!(eta->r > 0 && eta->g > 0 && eta->b > 0)) failAt(at, label + ": " + pre + "eta must be positive");
+    if (k->r < 0 || k->g < 0 || k->b < 0) failAt(at, label + ": " + pre + "k must not be negative");
   };
   if (type == "" || type == "interface" || type == "none") {
     slot.interface = true;
@@ -144,13 +167,14 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     m.specular = color(ps, "Kr", Rgb(0.9f));
     checkReflectance(ps, "Kr", m.specular);
   } else if (type == "glass" || type == "dielectric") {
-    m.type = T::Dielectric;
     double eta = floatParam(ps, "eta", ps.has("index") ? floatParam(ps, "index", 1.5) : 1.5);
     if (!(eta >= 1)) failAt(at, label + ": eta " + fmtNum(eta) + " below 1 is not supported");
     m.ior = float(eta);
     double alpha;
     roughness(type == "glass", 0, &alpha);
-    if (alpha != 0) failAt(at, label + ": rough glass is not supported (roughness must be 0)");
+    // Rough: GGX microfacet reflection and transmission (scene/bsdf_pbrt.cpp).
+    m.type = alpha < kSmoothAlpha ? T::Dielectric : T::RoughDielectric;
+    m.roughness = float(alpha);
     if (type == "glass") {
       Rgb kr = color(ps, "Kr", Rgb(1.0f)), kt = color(ps, "Kt", Rgb(1.0f));
       if (kr.r != kt.r || kr.g != kt.g || kr.b != kt.b)
@@ -160,54 +184,99 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     }
   } else if (type == "metal" || type == "conductor") {
     bool v3 = type == "metal";
-    Rgb r0;
-    if (!v3 && ps.has("reflectance")) {
-      r0 = color(ps, "reflectance", Rgb(1.0f));
-    } else {
-      // pbrt's default is copper (pbrt_spectrum.cpp: v3 reduces its copper
-      // against equal-energy white, v4 its metal-Cu under D65).
-      bool filmV3 = v3 || (film_.given && film_.type == "image");
-      Rgb cuEta = filmV3 ? Rgb(0.200964f, 0.923779f, 1.102306f) : Rgb(0.105133f, 0.977933f, 1.204671f);
-      Rgb cuK = filmV3 ? Rgb(3.912923f, 2.453080f, 2.142269f) : Rgb(3.273486f, 2.592516f, 2.369186f);
-      Rgb eta = color(ps, "eta", cuEta), k = color(ps, "k", cuK);
-      for (int i = 0; i < 3; ++i) r0[i] = reflectanceAtNormal(eta[i], k[i]);
-    }
-    checkReflectance(ps, "reflectance", r0);
+    conductorIor(v3, "", &m.eta, &m.k);
     double alpha;
     roughness(v3, v3 ? 0.01 : 0.0, &alpha);
-    if (alpha == 0) {
-      m.type = T::Mirror;  // a smooth conductor: its Fresnel curve becomes the constant normal-incidence value
-      m.specular = r0;
-    } else {
-      m.type = T::Metal;
-      m.specular = r0;
-      m.roughness = float(std::max(alpha, 1e-3));
-    }
-    note(at, label + ": conductor approximated by its reflectance at normal incidence (Schlick) with GGX alpha " +
-                 fmtNum(alpha) + " (see docs/pbrt-import.md)");
-  } else if (type == "plastic" || type == "coateddiffuse") {
-    bool v3 = type == "plastic";
-    m.type = T::Plastic;
-    std::string key = v3 ? "Kd" : "reflectance";
-    slot.checker = albedoChecker(ps, key);
-    m.albedo.color = slot.checker ? slot.checker->tex1 : color(ps, key, Rgb(v3 ? 0.25f : 0.5f));
-    checkReflectance(ps, key, m.albedo.color);
+    m.type = T::Conductor;  // alpha < 1e-3: smooth (scene/build.cpp)
+    m.roughness = float(alpha);
+  } else if (type == "plastic" || type == "uber" || type == "translucent" || type == "substrate") {
+    // pbrt-v3's plastic is exactly uber without Kr, Kt (Kd + Ks with
+    // dielectric Fresnel at eta 1.5); translucent keeps its reflection lobes.
+    bool substrate = type == "substrate";
+    m.type = substrate ? T::Substrate : T::Uber;
+    slot.checker = albedoChecker(ps, "Kd");
+    Rgb kdDefault(type == "plastic" || type == "uber" || type == "translucent" ? 0.25f : 0.5f);
+    m.albedo.color = slot.checker ? slot.checker->tex1 : color(ps, "Kd", kdDefault);
+    checkReflectance(ps, "Kd", m.albedo.color);
+    m.specular = color(ps, "Ks", Rgb(substrate ? 0.5f : 0.25f));
+    checkReflectance(ps, "Ks", m.specular);
     double alpha;
-    roughness(v3, v3 ? 0.1 : 0.0, &alpha);
+    roughness(true, 0.1, &alpha);
     m.roughness = float(std::max(alpha, 1e-3));
-    if (v3) {
-      color(ps, "Ks", Rgb(0.25f));
-      m.ior = 1.5f;
-    } else {
-      double eta = floatParam(ps, "eta", 1.5);
-      if (!(eta >= 1)) failAt(at, label + ": eta below 1 is not supported");
+    m.ior = 1.5f;
+    if (type == "uber") {
+      double eta = floatParam(ps, "eta", ps.has("index") ? floatParam(ps, "index", 1.5) : 1.5);
+      if (!(eta >= 1)) failAt(at, label + ": eta " + fmtNum(eta) + " below 1 is not supported");
       m.ior = float(eta);
-      Rgb albedo = color(ps, "albedo", Rgb(0.0f));
-      if (!albedo.isBlack()) failAt(at, label + ": a coating with a scattering albedo is not supported");
-      for (const char* q : {"thickness", "g", "maxdepth", "nsamples"}) ps.markUsed(q);
+      Rgb kr = color(ps, "Kr", Rgb(0.0f)), kt = color(ps, "Kt", Rgb(0.0f)), op = color(ps, "opacity", Rgb(1.0f));
+      if (op.r != 1 || op.g != 1 || op.b != 1) failAt(at, label + ": uber's opacity below 1 is not supported");
+      if (!kr.isBlack() || !kt.isBlack()) {
+        if (!m.albedo.color.isBlack() || !m.specular.isBlack() || slot.checker)
+          failAt(at, label + ": uber with specular lobes (Kr, Kt) beside Kd or Ks is not supported "
+                             "(tdpm's materials are delta-only or not at all)");
+        if (kr.r != kt.r || kr.g != kt.g || kr.b != kt.b)
+          failAt(at, label + ": uber's Kr and Kt differ; tdpm's dielectric has one tint for reflection and transmission");
+        checkReflectance(ps, "Kr", kr);
+        m.type = T::Dielectric;  // Kr Fresnel reflection + Kt Fresnel transmission: pbrt-v3's glass
+        m.specular = kr;
+      }
+    } else if (type == "translucent") {
+      Rgb r = color(ps, "reflect", Rgb(0.5f)), t = color(ps, "transmit", Rgb(0.5f));
+      (void)t;
+      m.albedo.color = m.albedo.color * r;
+      m.specular = m.specular * r;
+      if (slot.checker) failAt(at, label + ": a checkerboard Kd on translucent is not supported");
+      note(at, label + ": translucent approximated by its reflection lobes alone (Lambert reflect x Kd and GGX "
+                       "reflect x Ks, as uber); its transmission is dropped (see docs/pbrt-import.md)");
     }
-    note(at, label + ": " + type + " approximated by tdpm's plastic (Lambert base under a GGX dielectric coating, ior " +
-                 fmtNum(m.ior) + (v3 ? "; Ks ignored" : "; thickness ignored") + ")");
+  } else if (type == "coateddiffuse" || type == "coatedconductor") {
+    bool diffuse = type == "coateddiffuse";
+    std::string pre = diffuse ? "" : "interface.";
+    double eta = floatParam(ps, pre + "eta", 1.5);
+    if (!(eta >= 1)) failAt(at, label + ": eta below 1 is not supported");
+    m.ior = float(eta);
+    double alpha;
+    roughnessPre(pre, false, 0.0, &alpha);
+    m.roughness = float(std::max(alpha, 1e-3));
+    if (diffuse) {
+      m.type = T::CoatedDiffuse;
+      slot.checker = albedoChecker(ps, "reflectance");
+      m.albedo.color = slot.checker ? slot.checker->tex1 : color(ps, "reflectance", Rgb(0.5f));
+      checkReflectance(ps, "reflectance", m.albedo.color);
+    } else {
+      m.type = T::CoatedConductor;
+      conductorIor(false, "conductor.", &m.eta, &m.k);
+      double base;
+      roughnessPre("conductor.", false, 0.0, &base);
+      m.baseRoughness = float(std::max(base, 1e-3));
+    }
+    m.thickness = float(floatParam(ps, "thickness", 0.01));
+    if (!(m.thickness >= 0)) failAt(at, label + ": thickness must not be negative");
+    Rgb albedo = color(ps, "albedo", Rgb(0.0f));
+    if (!albedo.isBlack()) failAt(at, label + ": a coating with a scattering albedo is not supported");
+    for (const char* q : {"g", "maxdepth", "nsamples"}) ps.markUsed(q);
+    note(at, label + ": " + type + " approximated in closed form (scene/bsdf_pbrt.cpp: the coating's GGX lobe plus "
+                     "the base seen through a smooth interface; measured against a random walk in "
+                     "tests/test_materials.cpp; docs/pbrt-import.md)");
+  } else if (type == "mix") {
+    const Param* p = ps.find("materials");
+    if (!p || p->strings.size() != 2) failAt(at, label + ": mix needs \"string materials\" with two named materials");
+    p->used = true;
+    for (int i = 0; i < 2; ++i) {
+      auto it = namedMaterials_.find(p->strings[size_t(i)]);
+      if (it == namedMaterials_.end())
+        ps.fail(*p, "no material named \"" + p->strings[size_t(i)] + "\" has been made");
+      const MaterialSlot& c = materials_[size_t(it->second)];
+      if (c.interface) ps.fail(*p, "material \"" + p->strings[size_t(i)] + "\" is an interface; a mix needs surfaces");
+      if (c.checker) ps.fail(*p, "material \"" + p->strings[size_t(i)] + "\" has a checkerboard, which a mix does not support");
+      slot.mixSlots[i] = it->second;
+    }
+    m.type = T::Mix;
+    m.amount = float(floatParam(ps, "amount", 0.5));
+    if (!(m.amount >= 0 && m.amount <= 1)) failAt(at, label + ": amount must be in [0, 1]");
+  } else if (type == "measured") {
+    failAt(at, label + ": measured BSDFs (tabulated \"filename\" data) are not supported: tdpm has no tabulated "
+                       "BSDF; use a conductor or coateddiffuse of similar appearance");
   } else {
     failAt(at, "material type \"" + type + "\" is not supported (see docs/pbrt-import.md)");
   }
@@ -228,6 +297,8 @@ uint32_t Importer::materialIndex(int slot) {
   MaterialSlot& s = materials_[size_t(slot)];
   if (s.index < 0) {
     scene::MaterialDesc d = s.desc;
+    if (d.type == scene::MaterialDesc::Type::Mix)  // its components first (they were made before it)
+      for (int i = 0; i < 2; ++i) d.mix[i] = materialIndex(s.mixSlots[i]);
     d.name = uniqueMaterialName(d.name.empty() ? "material" + std::to_string(slot) : d.name);
     result.scene.materials.push_back(d);
     s.index = int(result.scene.materials.size()) - 1;

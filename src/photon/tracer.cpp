@@ -102,7 +102,7 @@ Bounds3f boundsOver(const SceneObject& o, float u0, float u1) {
 std::vector<Target> specularTargets(const Scene& scene, bool glossy, float u0 = 0.0f, float u1 = 1.0f) {
   std::vector<Target> t;
   for (const SceneObject& o : scene.objects)
-    if (glossy ? scene.materials[o.material].isCausticBounce() : scene.materials[o.material].isDeltaOnly()) {
+    if (scene.materials[o.material].causticTarget(glossy)) {
       Bounds3f b = boundsOver(o, u0, u1);
       t.push_back({b.center(), 0.5f * length(b.diagonal()) * 1.001f});
     }
@@ -434,7 +434,7 @@ struct Tracer {
       ++rays;
       if (!scene.intersect(origin, dir, std::numeric_limits<float>::infinity(), time01, hit)) return rays;
       if (hit.isLight()) return rays;  // emitters absorb
-      const Material& mat = scene.materials[scene.objects[hit.object].material];
+      const Material& mat = resolveMaterial(scene.materials.data(), scene.objects[hit.object].material, hit.p, -dir);
       // A sharp metal continues a caustic path (after storing there: the
       // caustic seen on the metal itself is L S+ G).
       bool glossyBounce = settings.glossyCaustics && mat.isGlossy();
@@ -605,7 +605,7 @@ void photonTimeRange(const Scene& scene, float& t0, float& t1) {
 
 bool sceneHasSpecular(const Scene& scene, bool glossy) {
   for (const SceneObject& o : scene.objects)
-    if (glossy ? scene.materials[o.material].isCausticBounce() : scene.materials[o.material].isDeltaOnly())
+    if (scene.materials[o.material].causticTarget(glossy))
       return true;
   return false;
 }

@@ -73,7 +73,9 @@ float median(float* v, int n) {
 int8_t quantizeUnit(float x) { return int8_t(std::lround(std::clamp(x, -1.0f, 1.0f) * 127.0f)); }
 
 bool diffuseLike(const Material& m) {
-  return m.type == Material::Type::Diffuse || m.type == Material::Type::Plastic;
+  using T = Material::Type;
+  return m.type == T::Diffuse || m.type == T::Plastic || m.type == T::Uber || m.type == T::Substrate ||
+         m.type == T::CoatedDiffuse;
 }
 
 }  // namespace

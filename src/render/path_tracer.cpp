@@ -69,7 +69,7 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
       break;  // emitters do not reflect
     }
     if (depth == maxDepth_) break;
-    const Material& mat = scene_.materials[scene_.objects[hit.object].material];
+    const Material& mat = resolveMaterial(scene_.materials.data(), scene_.objects[hit.object].material, hit.p, -dir);
     ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
 
     // Guide cones at the first two diffuse vertices: not only a caustic
@@ -98,7 +98,7 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
     }
     beta *= bs.weight;
     if (beta.isBlack() || !isFinite(beta)) break;
-    if (bs.delta && mat.type == Material::Type::Dielectric && (dot(bs.wi, hit.n) < 0) != (dot(-dir, hit.n) < 0)) {
+    if (mat.transmits() && (dot(bs.wi, hit.n) < 0) != (dot(-dir, hit.n) < 0)) {
       float eta = dot(-dir, hit.n) > 0 ? mat.ior : 1.0f / mat.ior;  // eta_t / eta_i
       etaScale *= eta * eta;
     }

@@ -133,7 +133,7 @@ Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, flo
         }
         break;
       }
-      const Material& m = scene_.materials[scene_.objects[h.object].material];
+      const Material& m = resolveMaterial(scene_.materials.data(), scene_.objects[h.object].material, h.p, -d);
       ShadingContext c = makeShadingContext(m, m.albedo.at(h.localP), h.n, -d);
       // Through mirrors, glass and sharp metals to the first diffuse-like
       // surface: light a sharp metal reflects toward the gather point is in
@@ -242,7 +242,7 @@ Rgb PhotonIntegrator::traceFrom(Vec3f origin, Vec3f dir, float time01, EyeVertex
       }
       break;
     }
-    const Material& mat = scene_.materials[scene_.objects[hit.object].material];
+    const Material& mat = resolveMaterial(scene_.materials.data(), scene_.objects[hit.object].material, hit.p, -dir);
     ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
     bool timeDependent = s_.timeDependent && touched;
     float minVolume = s_.footprintVolume * pathLength * pathLength;

@@ -1,11 +1,13 @@
 // scene/bsdf.cpp — Lambert, perfect mirror, Fresnel dielectric, GGX metal
-// and a Lambert-under-GGX-coating plastic.
+// and a Lambert-under-GGX-coating plastic; pbrt's materials are passed on
+// to scene/bsdf_pbrt.cpp.
 #include "scene/bsdf.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "sampling/warp.h"
+#include "scene/bsdf_pbrt.h"
 
 namespace tdpm {
 
@@ -75,8 +77,9 @@ ShadingContext makeShadingContext(const Material& m, Rgb albedo, Vec3f outwardNo
 
 Rgb bsdfEval(const ShadingContext& c, Vec3f wiWorld) {
   Vec3f wo = c.woLocal, wi = c.frame.toLocal(wiWorld);
-  if (wo.z <= 0 || wi.z <= 0) return Rgb(0.0f);
   const Material& m = *c.material;
+  if (m.type >= Material::Type::Conductor) return pbrtBsdfEval(c, wo, wi);  // pbrt's materials: bsdf_pbrt.cpp
+  if (wo.z <= 0 || wi.z <= 0) return Rgb(0.0f);
   switch (m.type) {
     case Material::Type::Diffuse:
       return c.albedo * kInvPi;
@@ -90,17 +93,16 @@ Rgb bsdfEval(const ShadingContext& c, Vec3f wiWorld) {
       float diffuseScale = (1.0f - fresnelDielectric(wo.z, m.ior)) * (1.0f - fresnelDielectric(wi.z, m.ior));
       return c.albedo * (diffuseScale * kInvPi) + Rgb(fs * ggxReflection(wo, wi, m.alpha));
     }
-    case Material::Type::Mirror:
-    case Material::Type::Dielectric:
+    default:  // mirror, dielectric: delta only
       return Rgb(0.0f);
   }
-  return Rgb(0.0f);
 }
 
 float bsdfPdf(const ShadingContext& c, Vec3f wiWorld) {
   Vec3f wo = c.woLocal, wi = c.frame.toLocal(wiWorld);
-  if (wo.z <= 0 || wi.z <= 0) return 0.0f;
   const Material& m = *c.material;
+  if (m.type >= Material::Type::Conductor) return pbrtBsdfPdf(c, wo, wi);
+  if (wo.z <= 0 || wi.z <= 0) return 0.0f;
   switch (m.type) {
     case Material::Type::Diffuse: return cosineHemispherePdf(wi.z);
     case Material::Type::Metal: return ggxPdfWi(wo, wi, m.alpha);
@@ -171,8 +173,8 @@ bool bsdfSample(const ShadingContext& c, Vec2f u, float uLobe, Transport mode, B
       out = {wiWorld, bsdfEval(c, wiWorld) * (wi.z / pdf), pdf, false};
       return true;
     }
+    default: return pbrtBsdfSample(c, u, uLobe, mode, out);
   }
-  return false;
 }
 
 }  // namespace tdpm

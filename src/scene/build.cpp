@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "scene/bsdf_pbrt.h"
 #include "scene/limits.h"
 #include "scene/scene.h"
 #include "scene/subdivision.h"
@@ -75,6 +76,13 @@ Material toMaterial(const scene::MaterialDesc& d) {
     case scene::MaterialDesc::Type::Dielectric: m.type = Material::Type::Dielectric; break;
     case scene::MaterialDesc::Type::Metal: m.type = Material::Type::Metal; break;
     case scene::MaterialDesc::Type::Plastic: m.type = Material::Type::Plastic; break;
+    case scene::MaterialDesc::Type::Conductor: m.type = Material::Type::Conductor; break;
+    case scene::MaterialDesc::Type::RoughDielectric: m.type = Material::Type::RoughDielectric; break;
+    case scene::MaterialDesc::Type::Uber: m.type = Material::Type::Uber; break;
+    case scene::MaterialDesc::Type::Substrate: m.type = Material::Type::Substrate; break;
+    case scene::MaterialDesc::Type::CoatedDiffuse: m.type = Material::Type::CoatedDiffuse; break;
+    case scene::MaterialDesc::Type::CoatedConductor: m.type = Material::Type::CoatedConductor; break;
+    case scene::MaterialDesc::Type::Mix: m.type = Material::Type::Mix; break;
   }
   m.albedo.kind = d.albedo.kind == scene::TextureDesc::Kind::Checker ? Texture::Kind::Checker : Texture::Kind::Constant;
   m.albedo.a = d.albedo.color;
@@ -84,7 +92,45 @@ Material toMaterial(const scene::MaterialDesc& d) {
   m.ior = d.ior;
   // Keep GGX away from alpha -> 0, where D is a numerically unstable spike.
   m.alpha = std::max(d.roughness, 1e-3f);
+  // pbrt's materials (scene/bsdf_pbrt.cpp): below pbrt-v4's smooth limit a
+  // conductor is delta and a dielectric the smooth one; a coating keeps the
+  // sharp GGX floor above (its delta lobe beside a diffuse one has no place
+  // in tdpm's delta / non-delta split: docs/scene-format.md).
+  using T = Material::Type;
+  if (m.type == T::Conductor) m.alpha = d.roughness < kSmoothAlpha ? 0.0f : d.roughness;
+  if (m.type == T::RoughDielectric && d.roughness < kSmoothAlpha) m.type = T::Dielectric;
+  m.eta = d.eta;
+  m.k = d.k;
+  if (m.type == T::CoatedConductor) {
+    m.eta = d.eta / d.ior;  // the conductor under the coating sees index ior, not 1
+    m.k = d.k / d.ior;
+    m.baseAlpha = std::max(d.baseRoughness, kSmoothAlpha);
+  }
+  m.thickness = d.thickness;
+  if (m.type == T::CoatedDiffuse || m.type == T::CoatedConductor) m.coatInternal = coatInternalReflectance(d.ior);
+  m.mixOf[0] = d.mix[0];
+  m.mixOf[1] = d.mix[1];
+  m.mixAmount = d.amount;
   return m;
+}
+
+// A mix's components' classification (Material::causticTarget), through
+// mixes of mixes (state: 0 unseen, 1 on the stack, 2 done); a mix that
+// reaches itself is refused.
+void classifyMix(std::vector<Material>& ms, const std::vector<scene::MaterialDesc>& desc, size_t i,
+                 std::vector<uint8_t>& state) {
+  if (state[i] == 2) return;
+  if (state[i] == 1) throw Error("material \"" + desc[i].name + "\": a mix material that contains itself");
+  state[i] = 1;
+  Material& m = ms[i];
+  for (uint32_t c : m.mixOf) {
+    if (c >= ms.size()) throw Error("material \"" + desc[i].name + "\": mix component index out of range");
+    if (ms[c].type == Material::Type::Mix) classifyMix(ms, desc, c, state);
+    const Material& k = ms[c];
+    m.mixDelta = m.mixDelta || k.isDeltaOnly() || k.mixDelta;
+    m.mixCaustic = m.mixCaustic || k.isCausticBounce() || k.mixCaustic;
+  }
+  state[i] = 2;
 }
 
 Light toLight(const scene::LightDesc& d, const Shutter& shutter) {
@@ -123,6 +169,9 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
   s.background = desc.background;
   s.hasMotion = s.camera.moving();
   for (const auto& m : desc.materials) s.materials.push_back(toMaterial(m));
+  std::vector<uint8_t> mixState(s.materials.size(), 0);
+  for (size_t i = 0; i < s.materials.size(); ++i)
+    if (s.materials[i].type == Material::Type::Mix) classifyMix(s.materials, desc.materials, i, mixState);
 
   for (const auto& od : desc.objects) {
     SceneObject o;

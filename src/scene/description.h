@@ -46,13 +46,20 @@ struct TextureDesc {
 };
 
 struct MaterialDesc {
-  enum class Type { Diffuse, Mirror, Dielectric, Metal, Plastic };
+  // Conductor .. Mix: pbrt's materials (scene/material.h, docs/scene-format.md).
+  enum class Type { Diffuse, Mirror, Dielectric, Metal, Plastic,
+                    Conductor, RoughDielectric, Uber, Substrate, CoatedDiffuse, CoatedConductor, Mix };
   Type type = Type::Diffuse;
   std::string name;
-  TextureDesc albedo;          // diffuse: reflectance; plastic: base colour
-  Rgb specular{1, 1, 1};       // mirror/metal: reflectance; dielectric: tint
-  float ior = 1.5f;            // dielectric and plastic coating, >= 1
-  float roughness = 0.2f;      // metal, plastic: GGX alpha in (0, 1]
+  TextureDesc albedo;          // diffuse: reflectance; plastic, uber, substrate, coateddiffuse: base colour
+  Rgb specular{1, 1, 1};       // mirror/metal: reflectance; dielectric: tint; uber, substrate: Ks
+  float ior = 1.5f;            // dielectric and plastic coating, >= 1; uber's Fresnel, coatings
+  float roughness = 0.2f;      // metal, plastic: GGX alpha in (0, 1]; the new types: in [0, 1] (0 = smooth)
+  Rgb eta{1, 1, 1}, k{0, 0, 0};  // conductor, coated conductor's base: complex IOR (absolute)
+  float baseRoughness = 0.0f;  // coated conductor: the conductor's GGX alpha in [0, 1]
+  float thickness = 0.01f;     // coated: the layer's thickness (pbrt-v4's units: optical depth)
+  uint32_t mix[2] = {0, 0};    // mix: indices into SceneDescription::materials
+  float amount = 0.5f;         // mix: probability of mix[1], in [0, 1]
 };
 
 struct ShapeDesc {

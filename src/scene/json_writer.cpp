@@ -75,7 +75,7 @@ Json texture(const scene::TextureDesc& t) {
   return Json{{"type", "checker"}, {"colors", Json::array({rgb(t.color), rgb(t.color2)})}, {"scale", num(t.scale)}};
 }
 
-Json material(const scene::MaterialDesc& m) {
+Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDesc>& materials) {
   using T = scene::MaterialDesc::Type;
   Json j;
   auto albedo = [&]() {
@@ -92,6 +92,47 @@ Json material(const scene::MaterialDesc& m) {
       albedo();
       j["ior"] = num(m.ior);
       j["roughness"] = num(m.roughness);
+      break;
+    case T::Conductor:
+      j["type"] = "conductor";
+      j["eta"] = rgb(m.eta);
+      j["k"] = rgb(m.k);
+      j["roughness"] = num(m.roughness);
+      break;
+    case T::RoughDielectric:
+      j["type"] = "dielectric";
+      j["ior"] = num(m.ior);
+      j["tint"] = rgb(m.specular);
+      j["roughness"] = num(m.roughness);
+      break;
+    case T::Uber:
+    case T::Substrate:
+      j["type"] = m.type == T::Uber ? "uber" : "substrate";
+      albedo();
+      j["specular"] = rgb(m.specular);
+      if (m.type == T::Uber) j["ior"] = num(m.ior);
+      j["roughness"] = num(m.roughness);
+      break;
+    case T::CoatedDiffuse:
+      j["type"] = "coateddiffuse";
+      albedo();
+      j["ior"] = num(m.ior);
+      j["roughness"] = num(m.roughness);
+      j["thickness"] = num(m.thickness);
+      break;
+    case T::CoatedConductor:
+      j["type"] = "coatedconductor";
+      j["ior"] = num(m.ior);
+      j["roughness"] = num(m.roughness);
+      j["eta"] = rgb(m.eta);
+      j["k"] = rgb(m.k);
+      j["conductor_roughness"] = num(m.baseRoughness);
+      j["thickness"] = num(m.thickness);
+      break;
+    case T::Mix:
+      j["type"] = "mix";
+      j["materials"] = Json::array({materials.at(m.mix[0]).name, materials.at(m.mix[1]).name});
+      j["amount"] = num(m.amount);
       break;
   }
   return j;
@@ -191,7 +232,7 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
   Json materials = Json::object();
   for (const auto& m : sc.materials) {
     if (materials.contains(m.name)) throw Error(jsonPath + ": two materials are named \"" + m.name + "\"");
-    materials[m.name] = material(m);
+    materials[m.name] = material(m, sc.materials);
   }
   root["materials"] = materials;
   Json objects = Json::array();

@@ -4,6 +4,7 @@
 #pragma once
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include "math/vec.h"
 
@@ -28,15 +29,36 @@ struct Texture {
 };
 
 struct Material {
-  enum class Type : uint8_t { Diffuse, Mirror, Dielectric, Metal, Plastic };
+  // Conductor .. Mix are pbrt's materials (issue 23; scene/bsdf_pbrt.cpp,
+  // docs/scene-format.md): Conductor is a complex-IOR Fresnel conductor
+  // (delta when alpha == 0), RoughDielectric a GGX microfacet dielectric
+  // (Walter et al. 2007), Uber pbrt-v3's uber without its specular lobes
+  // (Lambert + a GGX lobe with dielectric Fresnel), Substrate pbrt-v3's
+  // Ashikhmin-Shirley, CoatedDiffuse / CoatedConductor a closed-form
+  // approximation of pbrt-v4's layered BSDFs, Mix a per-hit choice between
+  // two other materials (resolved by resolveMaterial before any BSDF call).
+  enum class Type : uint8_t {
+    Diffuse, Mirror, Dielectric, Metal, Plastic,
+    Conductor, RoughDielectric, Uber, Substrate, CoatedDiffuse, CoatedConductor, Mix
+  };
   Type type = Type::Diffuse;
-  Texture albedo;            // diffuse reflectance / plastic base colour
-  Rgb specular{1.0f};        // mirror, metal reflectance; dielectric tint
-  float ior = 1.5f;          // dielectric, plastic coating
-  float alpha = 0.2f;        // GGX roughness (metal, plastic)
+  Texture albedo;            // diffuse reflectance / plastic, uber, substrate, coated-diffuse base colour
+  Rgb specular{1.0f};        // mirror, metal reflectance; dielectric tint; uber, substrate Ks
+  float ior = 1.5f;          // dielectric, plastic and coated coating, uber's Fresnel
+  float alpha = 0.2f;        // GGX roughness (metal, plastic; conductor, rough dielectric, uber, substrate, coatings)
+  Rgb eta{1.0f}, k{0.0f};    // conductor's complex IOR; coated conductor's, relative to the coating
+  float baseAlpha = 0.0f;    // coated conductor: the conductor's GGX alpha
+  float thickness = 0.01f;   // coated: the layer's optical depth along the normal (pbrt-v4's Tr)
+  float coatInternal = 0.0f; // coated: the layer's cosine-averaged internal reflectance (set at build)
+  uint32_t mixOf[2] = {0, 0};  // mix: the two materials' indices
+  float mixAmount = 0.5f;      // mix: probability of mixOf[1]
+  bool mixDelta = false, mixCaustic = false;  // mix: a component is delta-only / a caustic bounce (set at build)
 
-  // Purely delta (mirror, glass): no photon is stored here, no light sampling.
-  bool isDeltaOnly() const { return type == Type::Mirror || type == Type::Dielectric; }
+  // Purely delta (mirror, glass, smooth conductor): no photon is stored
+  // here, no light sampling.
+  bool isDeltaOnly() const {
+    return type == Type::Mirror || type == Type::Dielectric || (type == Type::Conductor && alpha == 0.0f);
+  }
   // A sharp metal (GGX alpha <= kGlossyAlpha): photons treat it like a
   // mirror for the caustic map (L (S|G)+ D paths), and final-gather rays
   // pass through it to the next diffuse surface instead of estimating there.
@@ -46,10 +68,43 @@ struct Material {
   // the steel post of scenes/glass-ball.json); as photons it is a smooth
   // density. Rougher metal and plastic stay diffuse-like gather surfaces.
   static constexpr float kGlossyAlpha = 0.2f;
-  bool isGlossy() const { return type == Type::Metal && alpha <= kGlossyAlpha; }
+  // A rough dielectric is always one: a gather point on it would estimate
+  // only the photons on the viewer's side, never the light it transmits.
+  bool isGlossy() const {
+    return ((type == Type::Metal || type == Type::Conductor) && alpha <= kGlossyAlpha && !isDeltaOnly()) ||
+           type == Type::RoughDielectric;
+  }
   // Caustic generators: what caustic photons are aimed at and bounce on.
   bool isCausticBounce() const { return isDeltaOnly() || isGlossy(); }
-  bool transmits() const { return type == Type::Dielectric; }
+  bool transmits() const { return type == Type::Dielectric || type == Type::RoughDielectric; }
+  // A photon-map target: this material or (mix) one of its components is
+  // delta-only (glossy: or a caustic bounce).
+  bool causticTarget(bool glossy) const { return glossy ? isCausticBounce() || mixCaustic : isDeltaOnly() || mixDelta; }
 };
+
+// The material a hit uses: a mix material picks one of its two per hit,
+// deterministically from the point and direction (as pbrt-v4's MixMaterial
+// hashes them), with probability mixAmount for the second; mixes of mixes
+// resolve in turn (scene/build.cpp refuses cycles).
+inline const Material& resolveMaterial(const Material* materials, uint32_t index, Vec3f p, Vec3f wo) {
+  const Material* m = materials + index;
+  while (m->type == Material::Type::Mix) {
+    if (m->mixAmount <= 0.0f) { m = materials + m->mixOf[0]; continue; }
+    if (m->mixAmount >= 1.0f) { m = materials + m->mixOf[1]; continue; }
+    float v[6] = {p.x, p.y, p.z, wo.x, wo.y, wo.z};
+    uint64_t h = 0x9E3779B97F4A7C15ull ^ (uint64_t(m->mixOf[0]) << 32 | m->mixOf[1]);
+    for (float f : v) {
+      uint32_t bits;
+      std::memcpy(&bits, &f, 4);
+      h = (h ^ bits) * 0xFF51AFD7ED558CCDull;
+      h ^= h >> 33;
+    }
+    h *= 0xC4CEB9FE1A85EC53ull;
+    h ^= h >> 33;
+    float u = float(h >> 40) * 0x1p-24f;
+    m = materials + (m->mixAmount < u ? m->mixOf[0] : m->mixOf[1]);
+  }
+  return *m;
+}
 
 }  // namespace tdpm

@@ -382,6 +382,33 @@ float readRoughness(const Node& n) {
   return r;
 }
 
+// pbrt's materials take roughness 0 for smooth (scene/build.cpp).
+float readRoughnessOrZero(const Node& n) {
+  float r = n.number();
+  n.require(r >= 0 && r <= 1, "roughness must be in [0, 1], got " + fmt(r));
+  return r;
+}
+
+// A conductor's complex IOR: "eta" and "k", or a normal-incidence
+// reflectance "color", which becomes eta = 1, k = 2 sqrt(r) / sqrt(1 - r)
+// (pbrt-v4's conductor "reflectance": the Fresnel curve through r).
+void readConductor(const Node& n, MaterialDesc* m) {
+  if (n.has("color") && (n.has("eta") || n.has("k")))
+    n.member("color").fail("give either \"color\" (a reflectance) or \"eta\" and \"k\", not both");
+  if (n.has("color")) {
+    Rgb r = readReflectance(n.member("color"));
+    m->eta = Rgb(1.0f);
+    for (int i = 0; i < 3; ++i) {
+      float ri = std::min(r[i], 0.9999f);
+      m->k[i] = 2.0f * std::sqrt(ri) / std::sqrt(1.0f - ri);
+    }
+    return;
+  }
+  m->eta = n.required("eta").color();
+  n.member("eta").require(m->eta.r > 0 && m->eta.g > 0 && m->eta.b > 0, "eta must be positive in every channel");
+  m->k = n.required("k").color();
+}
+
 struct MaterialKind {
   const char* name;
   MaterialDesc::Type type;
@@ -389,17 +416,27 @@ struct MaterialKind {
 };
 
 const std::vector<MaterialKind>& materialKinds() {
+  using T = MaterialDesc::Type;
   static const std::vector<MaterialKind> kinds = {
-      {"diffuse", MaterialDesc::Type::Diffuse, {"type", "color", "texture"}},
-      {"mirror", MaterialDesc::Type::Mirror, {"type", "color"}},
-      {"dielectric", MaterialDesc::Type::Dielectric, {"type", "ior", "tint"}},
-      {"metal", MaterialDesc::Type::Metal, {"type", "color", "roughness"}},
-      {"plastic", MaterialDesc::Type::Plastic, {"type", "color", "texture", "ior", "roughness"}},
+      {"diffuse", T::Diffuse, {"type", "color", "texture"}},
+      {"mirror", T::Mirror, {"type", "color"}},
+      {"dielectric", T::Dielectric, {"type", "ior", "tint", "roughness"}},
+      {"metal", T::Metal, {"type", "color", "roughness"}},
+      {"plastic", T::Plastic, {"type", "color", "texture", "ior", "roughness"}},
+      {"conductor", T::Conductor, {"type", "eta", "k", "color", "roughness"}},
+      {"uber", T::Uber, {"type", "color", "texture", "specular", "ior", "roughness"}},
+      {"substrate", T::Substrate, {"type", "color", "texture", "specular", "roughness"}},
+      {"coateddiffuse", T::CoatedDiffuse, {"type", "color", "texture", "ior", "roughness", "thickness"}},
+      {"coatedconductor", T::CoatedConductor,
+       {"type", "ior", "roughness", "eta", "k", "color", "conductor_roughness", "thickness"}},
+      {"mix", T::Mix, {"type", "materials", "amount"}},
   };
   return kinds;
 }
 
-MaterialDesc readMaterial(const Node& n, const std::string& name) {
+// mixNames: a mix's two component names, resolved by readMaterials.
+MaterialDesc readMaterial(const Node& n, const std::string& name, std::vector<std::string>* mixNames) {
+  using T = MaterialDesc::Type;
   n.requireObject();
   std::vector<std::string> names;
   for (const auto& k : materialKinds()) names.push_back(k.name);
@@ -410,21 +447,80 @@ MaterialDesc readMaterial(const Node& n, const std::string& name) {
   MaterialDesc m;
   m.name = name;
   m.type = kind.type;
-  bool albedo = kind.type == MaterialDesc::Type::Diffuse || kind.type == MaterialDesc::Type::Plastic;
-  if (albedo) m.albedo = readAlbedo(n);
-  else if (n.has("color")) m.specular = readReflectance(n.member("color"));
+  bool pbrtKind = kind.type >= T::Conductor;
+  if (kind.type == T::Mix) {
+    Node list = n.required("materials");
+    list.require(list.arraySize("2 material names") == 2, "expected an array of 2 material names");
+    for (size_t i = 0; i < 2; ++i) {
+      Node e = list.element(i);
+      if (!e.json().is_string()) e.fail("expected a string (a material name), got " + detail::describeKind(e.json()));
+      mixNames->push_back(e.string());
+    }
+    if (n.has("amount")) {
+      m.amount = n.member("amount").number();
+      n.member("amount").require(m.amount >= 0 && m.amount <= 1, "amount must be in [0, 1], got " + fmt(m.amount));
+    }
+    return m;
+  }
+  if (kind.type == T::Conductor || kind.type == T::CoatedConductor) {
+    readConductor(n, &m);
+  } else {
+    bool albedo = kind.type == T::Diffuse || kind.type == T::Plastic || kind.type == T::Uber ||
+                  kind.type == T::Substrate || kind.type == T::CoatedDiffuse;
+    if (albedo) m.albedo = readAlbedo(n);
+    else if (n.has("color")) m.specular = readReflectance(n.member("color"));
+  }
   if (n.has("tint")) m.specular = readReflectance(n.member("tint"));
+  if (n.has("specular")) m.specular = readReflectance(n.member("specular"));
+  else if (kind.type == T::Uber || kind.type == T::Substrate) m.specular = Rgb(0.25f);  // pbrt-v3's Ks
   if (n.has("ior")) m.ior = readIor(n.member("ior"));
-  if (n.has("roughness")) m.roughness = readRoughness(n.member("roughness"));
+  if (kind.type == T::Dielectric && n.has("roughness")) {
+    m.type = T::RoughDielectric;
+    pbrtKind = true;
+  }
+  if (pbrtKind) m.roughness = 0.0f;
+  if (n.has("roughness")) m.roughness = pbrtKind ? readRoughnessOrZero(n.member("roughness")) : readRoughness(n.member("roughness"));
+  if (n.has("conductor_roughness")) m.baseRoughness = readRoughnessOrZero(n.member("conductor_roughness"));
+  if (n.has("thickness")) {
+    m.thickness = n.member("thickness").number();
+    n.member("thickness").require(m.thickness >= 0 && std::isfinite(m.thickness), "thickness must be non-negative, got " + fmt(m.thickness));
+  }
   return m;
 }
 
 std::vector<MaterialDesc> readMaterials(const Node& n) {
   std::vector<MaterialDesc> out;
+  std::vector<std::pair<size_t, std::vector<std::string>>> mixes;
+  std::vector<Node> nodes;
   n.forEachMember([&](const std::string& name, const Node& m) {
     m.require(!name.empty(), "material names must not be empty");
-    out.push_back(readMaterial(m, name));
+    std::vector<std::string> mixNames;
+    out.push_back(readMaterial(m, name, &mixNames));
+    nodes.push_back(m);
+    if (!mixNames.empty()) mixes.push_back({out.size() - 1, mixNames});
   });
+  for (const auto& [i, mixNames] : mixes) {
+    for (size_t c = 0; c < 2; ++c) {
+      auto it = std::find_if(out.begin(), out.end(), [&](const MaterialDesc& d) { return d.name == mixNames[c]; });
+      Node e = nodes[i].member("materials").element(c);
+      if (it == out.end()) e.fail("unknown material \"" + mixNames[c] + "\"");
+      out[i].mix[c] = uint32_t(it - out.begin());
+    }
+  }
+  // A mix may not contain itself (through other mixes either).
+  for (const auto& [i, mixNames] : mixes) {
+    std::vector<size_t> stack = {out[i].mix[0], out[i].mix[1]};
+    std::vector<bool> seen(out.size(), false);
+    while (!stack.empty()) {
+      size_t j = stack.back();
+      stack.pop_back();
+      if (j == i) nodes[i].member("materials").fail("mix material \"" + out[i].name + "\" contains itself");
+      if (seen[j] || out[j].type != MaterialDesc::Type::Mix) continue;
+      seen[j] = true;
+      stack.push_back(out[j].mix[0]);
+      stack.push_back(out[j].mix[1]);
+    }
+  }
   return out;
 }
 
