@@ -435,19 +435,48 @@ TEST_CASE("pbrt materials map onto tdpm's, approximations as documented") {
   CHECK(glass.type == T::Dielectric);
   CHECK(glass.ior == 1.33f);
   CHECK(glass.specular.r == 0.9f);
-  // Conductor: reflectance at normal incidence ((eta-1)^2 + k^2) / ((eta+1)^2 + k^2).
+  // Conductor: its complex IOR as given (scene/bsdf_pbrt.cpp's Fresnel).
   auto metal = material("Material \"conductor\" \"rgb eta\" [0.2 0.2 0.2] \"rgb k\" [3 3 3] \"float roughness\" 0.09");
-  CHECK(metal.type == T::Metal);
-  CHECK(metal.specular.r == doctest::Approx((0.64 + 9) / (1.44 + 9)));
+  CHECK(metal.type == T::Conductor);
+  CHECK(metal.eta.r == 0.2f);
+  CHECK(metal.k.g == 3.0f);
   CHECK(metal.roughness == doctest::Approx(0.3));  // v4: alpha = sqrt(roughness)
   auto v3metal = material("Material \"metal\" \"rgb eta\" [0.2 0.2 0.2] \"rgb k\" [3 3 3] \"float roughness\" 0.3 \"bool remaproughness\" \"false\"");
   CHECK(v3metal.roughness == doctest::Approx(0.3));
-  CHECK(material("Material \"conductor\" \"rgb reflectance\" [0.8 0.8 0.8]").type == T::Mirror);  // smooth
+  auto smooth = material("Material \"conductor\" \"rgb reflectance\" [0.8 0.8 0.8]");
+  CHECK(smooth.type == T::Conductor);
+  CHECK(smooth.roughness == 0.0f);  // smooth: delta (scene/build.cpp)
+  CHECK(smooth.k.r == doctest::Approx(2 * std::sqrt(0.8) / std::sqrt(0.2)));  // eta = 1: normal Fresnel 0.8
   auto plastic = material("Material \"plastic\" \"rgb Kd\" [0.3 0.3 0.3] \"float roughness\" 0.01 \"bool remaproughness\" false");
-  CHECK(plastic.type == T::Plastic);
+  CHECK(plastic.type == T::Uber);  // pbrt-v3's plastic is Lambert + GGX with dielectric Fresnel, as uber
+  CHECK(plastic.specular.g == 0.25f);
   CHECK(plastic.roughness == doctest::Approx(0.01));
   auto coated = material("Material \"coateddiffuse\" \"rgb reflectance\" [0.3 0.6 0.3] \"float eta\" 1.6");
+  CHECK(coated.type == T::CoatedDiffuse);
   CHECK(coated.ior == 1.6f);
+  auto rough = material("Material \"dielectric\" \"float roughness\" 0.04");
+  CHECK(rough.type == T::RoughDielectric);
+  CHECK(rough.roughness == doctest::Approx(0.2));
+  auto uber = material("Material \"uber\" \"rgb Kd\" [0.64 0.64 0.64] \"rgb Ks\" [0.1 0.1 0.1] \"float index\" 1 \"float roughness\" 0.0104");
+  CHECK(uber.type == T::Uber);
+  CHECK(uber.ior == 1.0f);
+  CHECK(uber.specular.r == 0.1f);
+  auto uberGlass = material("Material \"uber\" \"rgb Kd\" [0 0 0] \"rgb Ks\" [0 0 0] \"rgb Kr\" [1 1 1] \"rgb Kt\" [1 1 1] \"float eta\" 1.4");
+  CHECK(uberGlass.type == T::Dielectric);
+  CHECK(uberGlass.ior == 1.4f);
+  CHECK(material("Material \"substrate\"").type == T::Substrate);
+  auto cc = material("Material \"coatedconductor\" \"float conductor.roughness\" 0.04 \"float interface.roughness\" 0");
+  CHECK(cc.type == T::CoatedConductor);
+  CHECK(cc.baseRoughness == doctest::Approx(0.2));
+  auto mix = importText("WorldBegin\nMakeNamedMaterial \"a\" \"string type\" \"diffuse\"\n"
+                        "MakeNamedMaterial \"b\" \"string type\" \"conductor\"\n"
+                        "Material \"mix\" \"string materials\" [\"a\" \"b\"] \"float amount\" 0.3\nShape \"sphere\"\n");
+  REQUIRE(mix.objects.size() == 1);
+  const auto& mm = mix.materials[mix.objects[0].material];
+  CHECK(mm.type == T::Mix);
+  CHECK(mm.amount == 0.3f);
+  CHECK(mix.materials[mm.mix[0]].type == T::Diffuse);
+  CHECK(mix.materials[mm.mix[1]].type == T::Conductor);
   CHECK(coated.albedo.color.g == 0.6f);
   CHECK(material("Texture \"t\" \"float\" \"constant\" \"float value\" 0.7\nMaterial \"diffuse\" \"texture reflectance\" \"t\"")
             .albedo.color.r == 0.7f);
@@ -556,7 +585,10 @@ TEST_CASE("pbrt errors name file:line and the statement or parameter") {
       {"Camera \"perspective\" \"float focaldistance\" 0\nWorldBegin\n", "dir/t.pbrt:1: Camera \"perspective\": parameter \"float focaldistance\": focaldistance must be in (0, "},
       {"Camera \"orthographic\"\nWorldBegin\n", "dir/t.pbrt:1: Camera \"orthographic\" is not supported"},
       {"Integrator \"bdpt\"\nWorldBegin\n", "dir/t.pbrt:1: Integrator \"bdpt\" is not supported"},
-      {"WorldBegin\nMaterial \"uber\"\n", "dir/t.pbrt:2: material type \"uber\" is not supported"},
+      {"WorldBegin\nMaterial \"measured\" \"string filename\" \"x.bsdf\"\n", "dir/t.pbrt:2: measured: measured BSDFs"},
+      {"WorldBegin\nMaterial \"hair\"\n", "dir/t.pbrt:2: material type \"hair\" is not supported"},
+      {"WorldBegin\nMaterial \"uber\" \"rgb Kr\" [1 1 1]\n", "dir/t.pbrt:2: uber: uber with specular lobes (Kr, Kt) beside Kd or Ks"},
+      {"WorldBegin\nMaterial \"mix\" \"string materials\" [\"p\" \"q\"]\n", "dir/t.pbrt:2: Material \"mix\": parameter \"string materials\": no material named \"p\""},
       {"WorldBegin\nMaterial \"conductor\" \"spectrum eta\" \"metal-CuZn-eta\"\n", "dir/t.pbrt:2: Material \"conductor\": parameter \"spectrum eta\": named spectrum \"metal-CuZn-eta\" is not available"},
       {"WorldBegin\nMaterial \"matte\" \"spectrum Kd\" [700 0.5 400 0.5]\n", "dir/t.pbrt:2: Material \"matte\": parameter \"spectrum Kd\": wavelengths must increase"},
       {"WorldBegin\nMaterial \"glass\" \"rgb Kr\" [1 1 1] \"rgb Kt\" [0.5 0.5 0.5]\n", "dir/t.pbrt:2: glass: Kr and Kt differ"},

@@ -134,24 +134,20 @@ bool roughDielectricSample(const ShadingContext& c, Vec2f u, float uLobe, Transp
   const Material& m = *c.material;
   Vec3f wo = c.woLocal;
   if (wo.z == 0) return false;
-  // The microfacet normal on wo's side (pbrt samples with wo flipped up).
-  Vec3f wm = ggx::sampleVisible(wo.z > 0 ? wo : -wo, u, m.alpha);
-  if (wo.z < 0) wm = -wm;
-  float R = fresnelDielectricSigned(dot(wo, wm), m.ior), Tr = 1.0f - R;
+  // The microfacet normal faces +z (pbrt-v4: from inside, dot(wo, wm) < 0
+  // and the Fresnel and the refraction invert eta).
+  Vec3f wm = ggx::sampleVisible(wo, u, m.alpha);
+  float R = fresnelDielectricSigned(dot(wo, wm), m.ior);
   Vec3f wi;
-  float pdf;
   if (uLobe < R) {
     wi = reflectAbout(wo, wm);
     if (wo.z * wi.z <= 0) return false;
   } else {
-    Vec3f n = wo.z > 0 ? Vec3f{0, 0, 1} : Vec3f{0, 0, -1};
-    if (dot(wm, n) < 0) wm = -wm;
-    if (!refract(wo, wm, wo.z > 0 ? m.ior : 1.0f / m.ior, wi)) return false;
+    if (!refract(wo, wm, m.ior, wi)) return false;
     wi = normalize(wi);
     if (wo.z * wi.z >= 0 || wi.z == 0) return false;
   }
-  (void)Tr;
-  pdf = roughDielectricPdf(m, wo, wi);
+  float pdf = roughDielectricPdf(m, wo, wi);
   if (!(pdf > 0)) return false;
   Rgb f = roughDielectricEval(m, wo, wi);
   if (mode == Transport::Importance && wo.z * wi.z < 0) {
