@@ -13,6 +13,7 @@
 #include "sampling/warp.h"
 #include "scene/bsdf.h"
 #include "scene/bsdf_pbrt.h"
+#include "import/pbrt_import.h"
 #include "scene/json_writer.h"
 #include "scene/parse.h"
 #include "scene/scene.h"
@@ -403,6 +404,77 @@ TEST_CASE("mix: the second material is chosen with probability amount, the same 
     double share = double(second) / n, sigma = std::sqrt(amount * (1 - amount) / n);
     CAPTURE(amount);
     CHECK(std::fabs(share - amount) <= 4 * sigma + 1e-9);
+  }
+}
+
+TEST_CASE("mix of mixes: each level chooses independently") {
+  // outer = mix(inner, C) at 0.5, inner = mix(A, B) at 0.3: A 0.35, B 0.15, C 0.5.
+  std::vector<Material> ms(5);
+  ms[0].type = T::Diffuse;
+  ms[1].type = T::Conductor;
+  ms[2].type = T::Uber;
+  ms[3].type = T::Mix;
+  ms[3].mixOf[0] = 0;
+  ms[3].mixOf[1] = 1;
+  ms[3].mixAmount = 0.3f;
+  ms[4].type = T::Mix;
+  ms[4].mixOf[0] = 3;
+  ms[4].mixOf[1] = 2;
+  ms[4].mixAmount = 0.5f;
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<float> U(-1.0f, 1.0f);
+  const int n = 40000;
+  int count[3] = {0, 0, 0};
+  for (int i = 0; i < n; ++i) {
+    Vec3f p{U(rng), U(rng), U(rng)}, wo = normalize(Vec3f{U(rng), U(rng), U(rng)});
+    ++count[&resolveMaterial(ms.data(), 4, p, wo) - ms.data()];
+  }
+  const double expect[3] = {0.35, 0.15, 0.5};
+  for (int k = 0; k < 3; ++k) {
+    double share = double(count[k]) / n, sigma = std::sqrt(expect[k] * (1 - expect[k]) / n);
+    CAPTURE(k);
+    CHECK(std::fabs(share - expect[k]) <= 4 * sigma);
+  }
+}
+
+TEST_CASE("pbrt materials through tdpm convert: the JSON renders the same pixels (mixes too)") {
+  // The JSON numbers materials in name order, the import in use order: the
+  // mix's choice must not depend on the numbering.
+  const char* text = R"(LookAt 0 1 5  0 0.5 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 24 "integer yresolution" 16
+WorldBegin
+LightSource "point" "rgb I" [10 10 10] "point3 from" [0 4 2]
+MakeNamedMaterial "zgold" "string type" "conductor" "float roughness" 0.01
+MakeNamedMaterial "apaint" "string type" "coateddiffuse" "rgb reflectance" [0.4 0.2 0.2] "float roughness" 0.02
+MakeNamedMaterial "half" "string type" "mix" "string materials" ["zgold" "apaint"] "float amount" 0.25
+AttributeBegin
+  NamedMaterial "half"
+  Shape "sphere" "float radius" 0.6
+AttributeEnd
+AttributeBegin
+  Material "dielectric" "float eta" 1.5 "float roughness" 0.05
+  Translate 1 0 0
+  Shape "sphere" "float radius" 0.3
+AttributeEnd
+AttributeBegin
+  Material "coatedconductor" "float interface.roughness" 0.01 "float conductor.roughness" 0.1 "rgb reflectance" [0.9 0.6 0.3]
+  Translate -1 0 0
+  Shape "sphere" "float radius" 0.3
+AttributeEnd
+Material "uber" "rgb Kd" [0.64 0.64 0.64] "rgb Ks" [0.1 0.1 0.1] "float index" 1.3
+Translate 0 -100 0
+Shape "sphere" "float radius" 100
+)";
+  scene::SceneDescription a = pbrt::importPbrtText(text, "mem.pbrt").scene;
+  scene::SceneDescription b = scene::parseScene(pbrt::sceneToJson(a, "/tmp/unused.json", false).json, "mem.json");
+  REQUIRE(a.materials.size() == b.materials.size());
+  bool reordered = false;
+  for (size_t i = 0; i < a.materials.size(); ++i) reordered = reordered || a.materials[i].name != b.materials[i].name;
+  CHECK(reordered);  // else this test would not test the numbering
+  for (RenderMethod method : {RenderMethod::PathTrace, RenderMethod::Time}) {
+    RenderOptions o = test::smallRenderOptions(method, 4, 6, 3);
+    CHECK(test::sameImage(test::renderOnce(a, o), test::renderOnce(b, o)));
   }
 }
 

@@ -85,24 +85,29 @@ struct Material {
 // The material a hit uses: a mix material picks one of its two per hit,
 // deterministically from the point and direction (as pbrt-v4's MixMaterial
 // hashes them), with probability mixAmount for the second; mixes of mixes
-// resolve in turn (scene/build.cpp refuses cycles).
+// resolve in turn, each level with its own hash (a shared one would tie the
+// inner choice to the outer). Material indices stay out of the hash: a
+// scene and its `tdpm convert` JSON number materials differently.
 inline const Material& resolveMaterial(const Material* materials, uint32_t index, Vec3f p, Vec3f wo) {
   const Material* m = materials + index;
-  while (m->type == Material::Type::Mix) {
-    if (m->mixAmount <= 0.0f) { m = materials + m->mixOf[0]; continue; }
-    if (m->mixAmount >= 1.0f) { m = materials + m->mixOf[1]; continue; }
-    float v[6] = {p.x, p.y, p.z, wo.x, wo.y, wo.z};
-    uint64_t h = 0x9E3779B97F4A7C15ull ^ (uint64_t(m->mixOf[0]) << 32 | m->mixOf[1]);
-    for (float f : v) {
-      uint32_t bits;
-      std::memcpy(&bits, &f, 4);
-      h = (h ^ bits) * 0xFF51AFD7ED558CCDull;
-      h ^= h >> 33;
-    }
-    h *= 0xC4CEB9FE1A85EC53ull;
+  if (m->type != Material::Type::Mix) return *m;
+  float v[6] = {p.x, p.y, p.z, wo.x, wo.y, wo.z};
+  uint64_t h = 0x9E3779B97F4A7C15ull;
+  for (float f : v) {
+    uint32_t bits;
+    std::memcpy(&bits, &f, 4);
+    h = (h ^ bits) * 0xFF51AFD7ED558CCDull;
     h ^= h >> 33;
-    float u = float(h >> 40) * 0x1p-24f;
-    m = materials + (m->mixAmount < u ? m->mixOf[0] : m->mixOf[1]);
+  }
+  while (m->type == Material::Type::Mix) {
+    h += 0x9E3779B97F4A7C15ull;  // splitmix64: one value per level
+    uint64_t z = h;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    float u = float(z >> 40) * 0x1p-24f;  // [0, 1)
+    // pbrt-v4: amount <= 0 is the first, >= 1 the second, else amount < u the first.
+    m = materials + (m->mixAmount < u || m->mixAmount <= 0.0f ? m->mixOf[0] : m->mixOf[1]);
   }
   return *m;
 }

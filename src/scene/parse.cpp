@@ -499,7 +499,9 @@ std::vector<MaterialDesc> readMaterials(const Node& n) {
     nodes.push_back(m);
     if (!mixNames.empty()) mixes.push_back({out.size() - 1, mixNames});
   });
-  for (const auto& [i, mixNames] : mixes) {
+  for (const auto& entry : mixes) {
+    size_t i = entry.first;
+    const std::vector<std::string>& mixNames = entry.second;  // not a structured binding: lambdas capture it
     for (size_t c = 0; c < 2; ++c) {
       auto it = std::find_if(out.begin(), out.end(), [&](const MaterialDesc& d) { return d.name == mixNames[c]; });
       Node e = nodes[i].member("materials").element(c);
@@ -508,7 +510,8 @@ std::vector<MaterialDesc> readMaterials(const Node& n) {
     }
   }
   // A mix may not contain itself (through other mixes either).
-  for (const auto& [i, mixNames] : mixes) {
+  for (const auto& entry : mixes) {
+    size_t i = entry.first;
     std::vector<size_t> stack = {out[i].mix[0], out[i].mix[1]};
     std::vector<bool> seen(out.size(), false);
     while (!stack.empty()) {
