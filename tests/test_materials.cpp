@@ -184,6 +184,18 @@ TEST_CASE("pbrt materials: sampled weights are eval |cos| / pdf, the pdf integra
   }
 }
 
+TEST_CASE("uber at ior 1 is Lambert: its glossy lobe has no Fresnel (caustic-glass's floor)") {
+  Material m = make(T::Uber, 0.05f, 1.0f);
+  m.specular = Rgb(0.1f);
+  for (float theta : {0.0f, 40.0f, 80.0f}) {
+    ShadingContext c = local(m, Rgb(0.64f), dirAt(theta));
+    CHECK(bsdfEval(c, dirAt(30, 2.0f)).g == doctest::Approx(0.64f * kInvPi).epsilon(1e-6));
+    Albedo a = sampledAlbedo(c, Transport::Radiance, 100000, 29);
+    CAPTURE(theta);
+    CHECK(std::fabs(a.mean - 0.64) <= 4 * a.stderr);
+  }
+}
+
 TEST_CASE("pbrt materials: reciprocity of the reflection lobes") {
   for (T t : kNonDelta) {
     Material m = make(t, 0.2f);
