@@ -488,7 +488,10 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
       }
     }
   } else if (s == "ReverseOrientation") {
-    failAt(at, "ReverseOrientation is not supported (tdpm cannot flip a sphere's or an emitter's orientation)");
+    // pbrt toggles the flag in the graphics state (AttributeEnd restores
+    // it, TransformEnd does not); each Shape records it (pbrt_mapping.cpp).
+    requireWorld(at, s);
+    gs_.reverseOrientation = !gs_.reverseOrientation;
   } else {
     failAt(at, "statement " + s + " is not supported by tdpm's pbrt import (see docs/pbrt-import.md)");
   }

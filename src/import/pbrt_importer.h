@@ -62,6 +62,9 @@ struct ShapeRecord {
   int material = 0;
   std::optional<AreaLight> area;
   Loc at;
+  // pbrt's ReverseOrientation in effect for this shape (as written: an
+  // emitter's side and ShapeDesc::reverseOrientation derive from it).
+  bool reverseOrientation = false;
 };
 
 struct GraphicsState {
@@ -69,6 +72,7 @@ struct GraphicsState {
   unsigned active = 3;  // ActiveTransform: bit 0 StartTime, bit 1 EndTime
   int material = 0;
   std::optional<AreaLight> area;
+  bool reverseOrientation = false;  // toggled by ReverseOrientation; restored by AttributeEnd
 };
 
 struct StackEntry {

@@ -212,7 +212,16 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
         if (s.loopLevels >= 0) j["shape"]["subdivision"] = Json{{"scheme", "loop"}, {"levels", s.loopLevels}};
         break;
       }
+      case scene::ShapeDesc::Type::Disk:
+        j["shape"] = Json{{"type", "disk"}, {"radius", num(s.radius)}, {"inner_radius", num(s.innerRadius)},
+                          {"height", num(s.height)}, {"phi_max", num(s.phiMax)}};
+        break;
+      case scene::ShapeDesc::Type::Cylinder:
+        j["shape"] = Json{{"type", "cylinder"}, {"radius", num(s.radius)}, {"z_min", num(s.zMin)}, {"z_max", num(s.zMax)},
+                          {"phi_max", num(s.phiMax)}};
+        break;
     }
+    if (s.reverseOrientation) j["shape"]["reverse_orientation"] = true;
     j["material"] = sc.materials.at(o.material).name;
     Json t = transform(o.placement);
     if (!t.empty()) j["transform"] = t;
