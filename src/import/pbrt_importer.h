@@ -152,6 +152,10 @@ class Importer {
   void countTriangles(uint64_t n, const Loc& at, const std::string& what, bool add = true);
   // Camera "perspective" lensradius / focaldistance (pbrt_camera.cpp).
   void readThinLens(const ParamSet& ps);
+  // bdpt / mlt: pathtrace or time, by the scene's lights and surfaces (pbrt_import.cpp).
+  void chooseBidirectionalMethod();
+  bool bidirectional_ = false;
+  Loc bidirectionalAt_;
 
   GraphicsState gs_;
   std::vector<StackEntry> stack_;

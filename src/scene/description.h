@@ -150,9 +150,14 @@ struct RenderSettings {
   std::optional<std::string> filter;  // box | gaussian
   std::optional<float> filterRadius;  // pixels, (0, 16]
   std::optional<int> maxDepth;        // path vertices, >= 1
+  std::optional<bool> directOnly;     // pathtrace: direct light only (RenderOptions::directOnly)
   std::optional<float> exposure;      // PNG preview: stops
   // photon methods
   std::optional<int64_t> photons;         // caustic photons stored, >= 0
+  // Caustic photons per pixel of the rendered image (pbrt's sppm
+  // photonsperiteration -1): photons = this x width x height, the
+  // resolution after --resolution. Not with `photons`.
+  std::optional<int64_t> photonsPerPixel;
   std::optional<int64_t> globalPhotons;   // global photons stored, >= 0
   std::optional<int> frames;              // accumulation, >= 1
   std::optional<std::string> search;      // twopass | 4d

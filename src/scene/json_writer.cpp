@@ -277,8 +277,10 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
   if (r.contrast) render["contrast"] = num(*r.contrast);
   if (r.seed) render["seed"] = *r.seed;
   if (r.maxDepth) render["max_depth"] = *r.maxDepth;
+  if (r.directOnly) render["direct_only"] = *r.directOnly;
   if (r.exposure) render["exposure"] = num(*r.exposure);
   if (r.photons) render["photons"] = *r.photons;
+  if (r.photonsPerPixel) render["photons_per_pixel"] = *r.photonsPerPixel;
   if (r.globalPhotons) render["global_photons"] = *r.globalPhotons;
   if (r.frames) render["frames"] = *r.frames;
   if (r.search) render["search"] = *r.search;

@@ -809,7 +809,8 @@ const std::vector<std::string> kTimeKernels = {"uniform", "epanechnikov"};
 RenderSettings readRender(const Node& n, float shutterLength) {
   n.expectObject({"method", "spp", "max_spp", "contrast", "seed", "max_depth", "exposure", "photons", "global_photons",
                   "frames", "search", "k", "fraction", "kappa", "max_radius", "max_dt", "kernel_space", "kernel_time",
-                  "gather", "sampler", "filter", "filter_radius", "progressive", "passes", "time_limit"});
+                  "gather", "sampler", "filter", "filter_radius", "progressive", "passes", "time_limit", "direct_only",
+                  "photons_per_pixel"});
   RenderSettings r;
   if (n.has("method")) r.method = n.member("method").choice(renderMethodNames(), "render method");
   if (n.has("spp")) r.spp = readCount(n.member("spp"), "spp", limits::kSpp);
@@ -843,6 +844,18 @@ RenderSettings readRender(const Node& n, float shutterLength) {
   }
   if (n.has("passes")) r.passes = readCount(n.member("passes"), "passes", limits::kPasses);
   if (n.has("time_limit")) r.timeLimit = readFloatInRange(n.member("time_limit"), "time_limit", limits::kTimeLimit);
+  if (n.has("direct_only")) {
+    Node p = n.member("direct_only");
+    p.require(p.json().is_boolean(), "expected true or false");
+    r.directOnly = p.json().get<bool>();
+    p.require(!*r.directOnly || !r.method || parseRenderMethod(*r.method) == RenderMethod::PathTrace,
+              "direct_only is a pathtrace setting; render.method is \"" + r.method.value_or("") + "\"");
+  }
+  if (n.has("photons_per_pixel")) {
+    Node p = n.member("photons_per_pixel");
+    p.require(!r.photons, "give photons or photons_per_pixel, not both");
+    r.photonsPerPixel = readInRange(p, "photons_per_pixel", {1, limits::kPhotons.hi});
+  }
   return r;
 }
 
