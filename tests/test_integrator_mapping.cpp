@@ -115,14 +115,17 @@ TEST_CASE("JSON direct_only and photons_per_pixel: checks") {
     return test::errorMessageOf(
         [&] { scene::parseScene(R"({"camera": {"resolution": [4, 4]}, "objects": [], "render": )" + render + "}", "dir/s.json"); });
   };
-  CHECK(errorOf(R"({"method": "time", "direct_only": true})").find("render.direct_only: direct_only is a pathtrace setting") !=
+  CHECK(errorOf(R"({"method": "time", "direct_only": true})")
+            .find("render.direct_only: direct_only is a pathtrace setting: it needs render.method \"pathtrace\", not \"time\"") !=
         std::string::npos);
+  CHECK(errorOf(R"({"direct_only": true})").find("it needs render.method \"pathtrace\" (none is given)") != std::string::npos);
+  CHECK(errorOf(R"({"method": "pathtrace", "direct_only": false})") == "(no error)");
   CHECK(errorOf(R"({"direct_only": 1})").find("render.direct_only: expected true or false") != std::string::npos);
   CHECK(errorOf(R"({"photons": 5, "photons_per_pixel": 2})").find("give photons or photons_per_pixel, not both") !=
         std::string::npos);
   CHECK(errorOf(R"({"photons_per_pixel": 0})").find("photons_per_pixel must be at least 1") != std::string::npos);
   // The method given on the command line is checked too.
-  scene::SceneDescription d = scene::parseScene(R"({"camera": {"resolution": [4, 4]}, "objects": [], "render": {"direct_only": true}})", "dir/s.json");
+  scene::SceneDescription d = scene::parseScene(R"({"camera": {"resolution": [4, 4]}, "objects": [], "render": {"method": "pathtrace", "direct_only": true}})", "dir/s.json");
   cli::RenderArgs a;
   a.scene = "dir/s.json";
   a.method = "time";

@@ -848,8 +848,11 @@ RenderSettings readRender(const Node& n, float shutterLength) {
     Node p = n.member("direct_only");
     p.require(p.json().is_boolean(), "expected true or false");
     r.directOnly = p.json().get<bool>();
-    p.require(!*r.directOnly || !r.method || parseRenderMethod(*r.method) == RenderMethod::PathTrace,
-              "direct_only is a pathtrace setting; render.method is \"" + r.method.value_or("") + "\"");
+    // Required rather than implied: a file that says direct_only and no
+    // method would otherwise render with the default method, not direct light.
+    p.require(!*r.directOnly || (r.method && parseRenderMethod(*r.method) == RenderMethod::PathTrace),
+              "direct_only is a pathtrace setting: it needs render.method \"pathtrace\"" +
+                  (r.method ? ", not \"" + *r.method + "\"" : std::string(" (none is given)")));
   }
   if (n.has("photons_per_pixel")) {
     Node p = n.member("photons_per_pixel");
