@@ -12,6 +12,7 @@
 #include "error_capture.h"
 #include "import/pbrt_import.h"
 #include "render_fixtures.h"
+#include "scene/bsdf.h"
 #include "scene/json_writer.h"
 #include "scene/parse.h"
 #include "scene/quadric.h"
@@ -187,6 +188,37 @@ TEST_CASE("disk and cylinder in a scene: placed hits, outward normals, reverse_o
   CHECK(h.n.z == doctest::Approx(-1.0f));
   REQUIRE(s2->intersect({5, 5, 0}, {0, -1, 0}, 1e30f, 0.5f, h));
   CHECK(h.n.y == doctest::Approx(-1.0f));
+}
+
+TEST_CASE("reverse_orientation turns glass inside out: total internal reflection where light would enter") {
+  // A glass disk (ior 1.5) hit from +z at 60 degrees: entering, Fresnel
+  // F = 0.0894 (fresnelDielectric); reversed, the ray is taken to leave the
+  // glass, and sin t = 1.5 sin 60 > 1: total internal reflection, F = 1.
+  for (bool reversed : {false, true}) {
+    CAPTURE(reversed);
+    auto d = test::emptyScene(4, 4);
+    scene::MaterialDesc glass;
+    glass.type = scene::MaterialDesc::Type::Dielectric;
+    glass.ior = 1.5f;
+    d.materials.push_back(glass);
+    d.objects.push_back(diskObject(1.0f, 0.0f, 0.0f, 360, 0));
+    d.objects.back().shape.reverseOrientation = reversed;
+    auto s = Scene::build(d);
+    Vec3f dir = normalize(Vec3f{std::sin(1.0471976f), 0, -std::cos(1.0471976f)});
+    Hit h;
+    REQUIRE(s->intersect(Vec3f{0, 0, 0} - dir * 2.0f, dir, 1e30f, 0.5f, h));
+    const Material& m = s->materials[0];
+    ShadingContext c = makeShadingContext(m, Rgb(1.0f), h.n, -dir);
+    BsdfSample refl, refr;
+    float F = dielectricBranches(c, Transport::Radiance, refl, refr);
+    if (reversed) {
+      CHECK(F == 1.0f);
+    } else {
+      CHECK(F == doctest::Approx(fresnelDielectric(0.5f, 1.5f)));
+      CHECK(F < 0.1f);
+      CHECK(refr.wi.z < 0);  // transmitted: through the disk
+    }
+  }
 }
 
 TEST_CASE("a moving cylinder is where its motion puts it at the ray's time") {
