@@ -436,8 +436,8 @@ TEST_CASE("pbrt: texture errors name every supported kind and type") {
 TEST_CASE("pbrt: options errors are reported in file order (the first wrong statement, not the first mapped)") {
   // Film is mapped before Camera and Integrator (their values depend on
   // it), but the error named is the first in the file.
-  CHECK(errorOf("Integrator \"bdpt\"\nCamera \"orthographic\"\nFilm \"bogus\"\nWorldBegin\n") ==
-        "dir/q.pbrt:1: Integrator \"bdpt\" is not supported (path, volpath, sppm)");
+  CHECK(errorOf("Integrator \"ambientocclusion\"\nCamera \"orthographic\"\nFilm \"bogus\"\nWorldBegin\n") ==
+        "dir/q.pbrt:1: Integrator \"ambientocclusion\" is not supported (path, volpath, directlighting, bdpt, mlt, sppm)");
   CHECK(errorOf("Camera \"orthographic\"\nFilm \"bogus\"\nWorldBegin\n") ==
         "dir/q.pbrt:1: Camera \"orthographic\" is not supported (only perspective)");
   CHECK(errorOf("Film \"bogus\"\nCamera \"orthographic\"\nWorldBegin\n") ==

@@ -139,6 +139,25 @@ AttributeBegin
   Scale 0.3 0.3 0.3
   Shape "sphere"
 AttributeEnd
+AttributeBegin
+  Material "dielectric" "float eta" 1.3
+  Translate -1.5 0 0.5
+  Rotate -90 1 0 0
+  ReverseOrientation
+  Shape "cylinder" "float radius" 0.3 "float zmin" 0 "float zmax" 0.8 "float phimax" 300
+  Shape "disk" "float radius" 0.3 "float height" 0.8
+AttributeEnd
+AttributeBegin
+  NamedMaterial "red"
+  ActiveTransform EndTime
+  Translate 0.2 0 0
+  ActiveTransform All
+  Translate 1.6 0.01 1
+  Scale 1 1 0.5
+  Rotate -90 1 0 0
+  Shape "disk" "float radius" 0.4 "float innerradius" 0.1
+AttributeEnd
+Shape "bilinearmesh" "point3 P" [1 0 -1  2 0 -1  1 1 -1  2 1.5 -0.5]
 )";
 
 }  // namespace
@@ -576,7 +595,7 @@ TEST_CASE("pbrt errors name file:line and the statement or parameter") {
     std::string text, expected;
   };
   const Case cases[] = {
-      {"WorldBegin\nShape \"cylinder\"\n", "dir/t.pbrt:2: Shape \"cylinder\" is not supported"},
+      {"WorldBegin\nShape \"hyperboloid\"\n", "dir/t.pbrt:2: Shape \"hyperboloid\" is not supported (sphere, disk, cylinder,"},
       {"WorldBegin\n\nShape \"sphere\" \"float zmax\" 0.5\n", "dir/t.pbrt:3: Shape \"sphere\": partial spheres"},
       {"WorldBegin\nShape \"sphere\" \"float radius\" 1 \"float bogus\" 2\n",
        "dir/t.pbrt:2: Shape \"sphere\": parameter \"float bogus\": not supported"},
@@ -584,11 +603,11 @@ TEST_CASE("pbrt errors name file:line and the statement or parameter") {
       {"Camera \"perspective\" \"float lensradius\" -0.1\nWorldBegin\n", "dir/t.pbrt:1: Camera \"perspective\": parameter \"float lensradius\": lensradius must be in [0, "},
       {"Camera \"perspective\" \"float focaldistance\" 0\nWorldBegin\n", "dir/t.pbrt:1: Camera \"perspective\": parameter \"float focaldistance\": focaldistance must be in (0, "},
       {"Camera \"orthographic\"\nWorldBegin\n", "dir/t.pbrt:1: Camera \"orthographic\" is not supported"},
-      {"Integrator \"bdpt\"\nWorldBegin\n", "dir/t.pbrt:1: Integrator \"bdpt\" is not supported"},
       {"WorldBegin\nMaterial \"measured\" \"string filename\" \"x.bsdf\"\n", "dir/t.pbrt:2: measured: measured BSDFs"},
       {"WorldBegin\nMaterial \"hair\"\n", "dir/t.pbrt:2: material type \"hair\" is not supported"},
       {"WorldBegin\nMaterial \"uber\" \"rgb Kr\" [1 1 1]\n", "dir/t.pbrt:2: uber: uber with specular lobes (Kr, Kt) beside Kd or Ks"},
       {"WorldBegin\nMaterial \"mix\" \"string materials\" [\"p\" \"q\"]\n", "dir/t.pbrt:2: Material \"mix\": parameter \"string materials\": no material named \"p\""},
+      {"Integrator \"whitted\"\nWorldBegin\n", "dir/t.pbrt:1: Integrator \"whitted\" is not supported"},
       {"WorldBegin\nMaterial \"conductor\" \"spectrum eta\" \"metal-CuZn-eta\"\n", "dir/t.pbrt:2: Material \"conductor\": parameter \"spectrum eta\": named spectrum \"metal-CuZn-eta\" is not available"},
       {"WorldBegin\nMaterial \"matte\" \"spectrum Kd\" [700 0.5 400 0.5]\n", "dir/t.pbrt:2: Material \"matte\": parameter \"spectrum Kd\": wavelengths must increase"},
       {"WorldBegin\nMaterial \"glass\" \"rgb Kr\" [1 1 1] \"rgb Kt\" [0.5 0.5 0.5]\n", "dir/t.pbrt:2: glass: Kr and Kt differ"},
@@ -602,9 +621,14 @@ TEST_CASE("pbrt errors name file:line and the statement or parameter") {
        "dir/t.pbrt:3: AreaLightSource (dir/t.pbrt:2) on Shape \"trianglemesh\": tdpm's area lights are rectangles"},
       {"WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 3]\n",
        "dir/t.pbrt:2: Shape \"trianglemesh\": parameter \"integer indices\": index 3 is out of range"},
-      {"WorldBegin\nShape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 1]\n", "dir/t.pbrt:2: Shape \"bilinearmesh\": patch 0 is not a flat parallelogram"},
+      {"WorldBegin\nShape \"disk\" \"float radius\" -1\n", "dir/t.pbrt:2: Shape \"disk\": radius must be positive, got -1"},
+      {"WorldBegin\nShape \"disk\" \"float innerradius\" 2\n", "dir/t.pbrt:2: Shape \"disk\": innerradius 2 must be below radius 1"},
+      {"WorldBegin\nShape \"cylinder\" \"float zmin\" 1 \"float zmax\" 0\n", "dir/t.pbrt:2: Shape \"cylinder\": zmin 1 must be below zmax 0"},
+      {"WorldBegin\nShape \"cylinder\" \"float radius\" 0\n", "dir/t.pbrt:2: Shape \"cylinder\": radius must be positive, got 0"},
+      {"WorldBegin\nShape \"cylinder\" \"float phimax\" -5\n", "dir/t.pbrt:2: Shape \"cylinder\": phimax must be positive"},
+      {"WorldBegin\nAreaLightSource \"diffuse\"\nShape \"disk\"\n", "dir/t.pbrt:3: Shape \"disk\" with an AreaLightSource"},
+      {"ReverseOrientation\nWorldBegin\n", "dir/t.pbrt:1: ReverseOrientation is only allowed after WorldBegin"},
       {"WorldBegin\nScale 2 1 1\nShape \"sphere\"\n", "dir/t.pbrt:3: Shape \"sphere\" under a non-uniform scale"},
-      {"WorldBegin\nReverseOrientation\n", "dir/t.pbrt:2: ReverseOrientation is not supported"},
       {"WorldBegin\nMakeNamedMedium \"fog\"\n", "dir/t.pbrt:2: statement MakeNamedMedium is not supported"},
       {"WorldBegin\nAttributeBegin\n", "dir/t.pbrt:2: AttributeBegin without a matching End"},
       {"WorldBegin\nAttributeEnd\n", "dir/t.pbrt:2: AttributeEnd without a matching AttributeBegin"},
@@ -832,10 +856,10 @@ TEST_CASE("cli: render chooses the pbrt import by extension and names the output
   CHECK(n.exitCode == 0);
   CHECK(test::fileExists(dir + "/pic.exr"));
   // A located error, exit 1, nothing written.
-  test::writeFile(dir + "/bad.pbrt", "WorldBegin\n\nShape \"disk\"\n");
+  test::writeFile(dir + "/bad.pbrt", "WorldBegin\n\nShape \"hyperboloid\"\n");
   auto b = test::runTdpm("render '" + dir + "/bad.pbrt' -o '" + dir + "/bad.exr' -q");
   CHECK(b.exitCode == 1);
-  CHECK(b.output.find("bad.pbrt:3: Shape \"disk\" is not supported") != std::string::npos);
+  CHECK(b.output.find("bad.pbrt:3: Shape \"hyperboloid\" is not supported") != std::string::npos);
   CHECK(!test::fileExists(dir + "/bad.exr"));
   std::filesystem::remove_all(dir);
 }
@@ -862,7 +886,7 @@ TEST_CASE("cli: convert writes JSON (+ OBJ) that renders to the same image as th
   CHECK(test::runTdpm("convert '" + dir + "/f.json' -o '" + dir + "/x.json'").exitCode == 1);
   CHECK(test::runTdpm("convert '" + dir + "/f.pbrt' -o '" + dir + "/x.txt'").exitCode == 1);
   CHECK(test::runTdpm("convert '" + dir + "/f.pbrt'").exitCode == 2);
-  test::writeFile(dir + "/bad.pbrt", "WorldBegin\nShape \"disk\"\n");
+  test::writeFile(dir + "/bad.pbrt", "WorldBegin\nShape \"hyperboloid\"\n");
   auto b = test::runTdpm("convert '" + dir + "/bad.pbrt' -o '" + dir + "/bad.json'");
   CHECK(b.exitCode == 1);
   CHECK(!test::fileExists(dir + "/bad.json"));

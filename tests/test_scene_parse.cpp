@@ -348,7 +348,7 @@ TEST_CASE("scene parse: required keys, unknown keys, wrong types") {
             "unknown key \"positon\" (did you mean \"position\"?); allowed keys: focal_distance, fov, lens_radius, "
             "motion, position, resolution, shutter, target, up");
   checkEdit([](Json& j) { j["objects"][0]["shape"]["colour"] = 1; }, "objects[0].shape.colour",
-            "unknown key \"colour\"; allowed keys: radius, type");
+            "unknown key \"colour\"; allowed keys: radius, reverse_orientation, type");
   checkEdit([](Json& j) { j["camera"] = "front"; }, "camera", "expected an object, got a string");
   checkEdit([](Json& j) { j["objects"] = Json::object(); }, "objects", "expected an array of objects, got an object");
   checkEdit([](Json& j) { j["camera"]["position"] = "origin"; }, "camera.position",
@@ -489,8 +489,8 @@ TEST_CASE("scene parse: shapes") {
   checkEdit([](Json& j) { j["objects"][0].erase("shape"); }, "objects[0]", "missing required key \"shape\"");
   checkEdit([](Json& j) { j["objects"][0]["shape"] = {{"radius", 1}}; }, "objects[0].shape",
             "missing required key \"type\"");
-  checkEdit([](Json& j) { j["objects"][0]["shape"]["type"] = "cylinder"; }, "objects[0].shape.type",
-            "unknown shape type \"cylinder\"; expected one of sphere, quad, box, mesh");
+  checkEdit([](Json& j) { j["objects"][0]["shape"]["type"] = "torus"; }, "objects[0].shape.type",
+            "unknown shape type \"torus\"; expected one of sphere, quad, box, mesh, disk, cylinder");
   checkEdit([](Json& j) { j["objects"][0]["shape"]["radius"] = -1; }, "objects[0].shape.radius",
             "radius must be positive, got -1");
   checkEdit([](Json& j) { j["objects"][0]["shape"]["radius"] = 0; }, "objects[0].shape.radius",
@@ -627,9 +627,9 @@ TEST_CASE("scene parse: render settings and background") {
             "seed must be a non-negative integer, got a string");
   checkEdit([](Json& j) { j["render"] = {{"exposure", "+1"}}; }, "render.exposure", "expected a number, got a string");
   checkEdit([](Json& j) { j["render"] = {{"threads", 4}}; }, "render.threads",
-            "unknown key \"threads\"; allowed keys: contrast, exposure, filter, filter_radius, fraction, frames, gather, "
-            "global_photons, k, kappa, kernel_space, kernel_time, max_depth, max_dt, max_radius, max_spp, method, passes, "
-            "photons, progressive, sampler, search, seed, spp, time_limit");
+            "unknown key \"threads\"; allowed keys: contrast, direct_only, exposure, filter, filter_radius, fraction, frames, "
+            "gather, global_photons, k, kappa, kernel_space, kernel_time, max_depth, max_dt, max_radius, max_spp, method, "
+            "passes, photons, photons_per_pixel, progressive, sampler, search, seed, spp, time_limit");
   checkEdit([](Json& j) { j["render"] = {{"sampler", "halton"}}; }, "render.sampler", "halton");
   checkEdit([](Json& j) { j["render"] = {{"filter", "mitchell"}}; }, "render.filter",
             "unknown filter \"mitchell\"; expected one of box, gaussian");

@@ -205,6 +205,25 @@ estimate::TimeKernel timeKernelFrom(const std::string& s) {
   return s == "epanechnikov" ? estimate::TimeKernel::Epanechnikov : estimate::TimeKernel::Uniform;
 }
 
+// render.photons_per_pixel (pbrt's sppm photonsperiteration -1): the
+// caustic photon count from the resolution actually rendered (desc's camera,
+// after --resolution), unless --photons gives one.
+void applyPhotonsPerPixel(const RenderArgs& a, const scene::SceneDescription& desc,
+                          const std::map<std::string, std::string>& settingSources, RenderOptions& o) {
+  const std::optional<int64_t>& ppp = desc.render.photonsPerPixel;
+  if (a.photons || !ppp) return;
+  const int64_t pixels = int64_t(desc.camera.width) * desc.camera.height;
+  auto it = settingSources.find("photons");
+  std::string source = it != settingSources.end() ? it->second : "render.photons_per_pixel in " + a.scene;
+  if (*ppp > limits::kPhotons.hi / pixels)
+    throw Error(source + ": " + std::to_string(*ppp) + " photons per pixel x " + std::to_string(desc.camera.width) + "x" +
+                std::to_string(desc.camera.height) + " pixels is more than tdpm's limit of " +
+                std::to_string(limits::kPhotons.hi) + " photons");
+  o.causticPhotons = size_t(*ppp * pixels);
+  o.causticPhotonsSource = source + " (" + std::to_string(*ppp) + " x " + std::to_string(desc.camera.width) + "x" +
+                           std::to_string(desc.camera.height) + " pixels)";
+}
+
 // Merges flags over the scene's settings over the renderer's defaults.
 RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath) {
   RenderOptions o;
@@ -220,6 +239,12 @@ RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc,
   parseFilterKind(pick(a.filter, sc.filter, std::string(filterName(o.filter))), o.filter);
   o.filterRadius = pick(a.filterRadius, sc.filterRadius, o.filterRadius);
   o.maxDepth = pick(a.maxDepth, sc.maxDepth, o.maxDepth);
+  o.directOnly = sc.directOnly.value_or(false);
+  if (o.directOnly && o.method != RenderMethod::PathTrace)
+    throw Error("render.direct_only in " + sourcePath + " is a pathtrace setting, but the method is " +
+                renderMethodName(o.method) + (a.method ? " (--method)" : ""));
+  // A direct-only path never reaches a caustic: no guide photons to trace.
+  if (o.directOnly && !a.causticGuiding) o.causticGuiding = 0.0f;
   o.causticGuiding = a.causticGuiding.value_or(o.causticGuiding);
   o.causticPhotons = size_t(pick(a.photons, sc.photons, int64_t(o.causticPhotons)));
   o.globalPhotons = size_t(pick(a.globalPhotons, sc.globalPhotons, int64_t(o.globalPhotons)));
@@ -291,7 +316,9 @@ void warnAccumulationPhotons(const RenderOptions& o, bool hasMotion, const Rende
 }  // namespace
 
 RenderOptions renderOptionsFor(const RenderArgs& a, const scene::SceneDescription& desc) {
-  return mergeOptions(a, desc.render, a.scene);
+  RenderOptions o = mergeOptions(a, desc.render, a.scene);
+  applyPhotonsPerPixel(a, desc, {}, o);
+  return o;
 }
 
 // The flag table, one statement per flag in --help order: longer than 80
@@ -475,6 +502,7 @@ void loadRenderSetup(const RenderArgs& a, dist::Comm& comm, bool framePattern, R
   } else {
     s.opt.resolutionSource = "camera.resolution in " + a.scene;
   }
+  applyPhotonsPerPixel(a, s.desc, settingSources, s.opt);
   s.scene = Scene::build(s.desc);
 }
 

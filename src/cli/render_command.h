@@ -54,7 +54,8 @@ struct RenderArgs {
 CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args);
 // The render options of `args` over the scene's "render" block over the
 // defaults (what runRender renders with, before --resolution is applied to
-// the scene's camera). Throws tdpm::Error for contradictory settings.
+// the scene's camera; render.photons_per_pixel is sized from desc's camera).
+// Throws tdpm::Error for contradictory settings.
 RenderOptions renderOptionsFor(const RenderArgs& args, const scene::SceneDescription& desc);
 int runRender(const RenderArgs& args);
 

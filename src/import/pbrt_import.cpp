@@ -488,7 +488,10 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
       }
     }
   } else if (s == "ReverseOrientation") {
-    failAt(at, "ReverseOrientation is not supported (tdpm cannot flip a sphere's or an emitter's orientation)");
+    // pbrt toggles the flag in the graphics state (AttributeEnd restores
+    // it, TransformEnd does not); each Shape records it (pbrt_mapping.cpp).
+    requireWorld(at, s);
+    gs_.reverseOrientation = !gs_.reverseOrientation;
   } else {
     failAt(at, "statement " + s + " is not supported by tdpm's pbrt import (see docs/pbrt-import.md)");
   }
@@ -716,13 +719,31 @@ void Importer::worldBegin(const Loc& at) {
   int maxDepth = integrator_.given ? ip.getInt("maxdepth", 5) : 5;
   if (maxDepth < 1) failAt(iat, "Integrator: maxdepth " + std::to_string(maxDepth) + " (emission only) is not supported; tdpm needs at least 1");
   r.maxDepth = maxDepth;
-  if (integ == "path" || integ == "volpath") {
-    r.method = "pathtrace";
-    for (const char* q : {"regularize", "lightsampler", "rrthreshold"})
+  auto qualityOnly = [&](std::initializer_list<const char*> names) {
+    for (const char* q : names)
       if (ip.has(q)) {
         ip.markUsed(q);
         note(iat, std::string("Integrator: \"") + q + "\" ignored (quality only)");
       }
+  };
+  if (integ == "path" || integ == "volpath") {
+    // volpath without media is path tracing; a medium statement is refused
+    // where it stands (media are another issue).
+    r.method = "pathtrace";
+    qualityOnly({"regularize", "lightsampler", "rrthreshold"});
+  } else if (integ == "directlighting") {
+    r.method = "pathtrace";
+    r.directOnly = true;
+    qualityOnly({"strategy"});
+    note(iat, "Integrator \"directlighting\" mapped to pathtrace with render.direct_only: direct light at the first "
+              "non-specular surface, through perfect-specular bounces up to maxdepth, as pbrt");
+  } else if (integ == "bdpt" || integ == "mlt") {
+    // Decided in finish(), once the lights and materials are known.
+    r.method = "pathtrace";
+    bidirectional_ = true;
+    bidirectionalAt_ = iat;
+    qualityOnly({"regularize", "lightsampler", "visualizestrategies", "visualizeweights", "bootstrapsamples", "chains",
+                 "mutationsperpixel", "largestepprobability", "sigma"});
   } else if (integ == "sppm") {
     // The progressive method does not exist yet: the photon count of all
     // iterations goes into one pass of the time-dependent photon method.
@@ -731,20 +752,30 @@ void Importer::worldBegin(const Loc& at) {
     double radius = ip.getFloat("radius", 1.0);
     if (iterations < 1) failAt(iat, "Integrator \"sppm\": numiterations must be at least 1");
     if (!(radius > 0)) failAt(iat, "Integrator \"sppm\": radius must be positive");
-    int64_t per = perIteration > 0 ? perIteration : int64_t(width) * height;
     r.method = "time";
-    if (per > kMaxPhotons / iterations)
-      failAt(iat, "Integrator \"sppm\": photonsperiteration x numiterations = " + std::to_string(per) + " x " +
-                      std::to_string(iterations) + " photons is more than tdpm's limit of " + std::to_string(kMaxPhotons) +
-                      " (render.photons)");
-    r.photons = per * iterations;
-    result.settingSources["photons"] = iat.str() + ": Integrator \"sppm\" (photonsperiteration x numiterations)";
+    std::string count;
+    if (perIteration > 0) {
+      int64_t per = perIteration;
+      if (per > kMaxPhotons / iterations)
+        failAt(iat, "Integrator \"sppm\": photonsperiteration x numiterations = " + std::to_string(per) + " x " +
+                        std::to_string(iterations) + " photons is more than tdpm's limit of " + std::to_string(kMaxPhotons) +
+                        " (render.photons)");
+      r.photons = per * iterations;
+      result.settingSources["photons"] = iat.str() + ": Integrator \"sppm\" (photonsperiteration x numiterations)";
+      count = "photons = photonsperiteration x numiterations = " + std::to_string(*r.photons);
+    } else {
+      // pbrt's -1: one photon per pixel per iteration, of the image rendered
+      // (--resolution included), so the count is fixed at render time.
+      r.photonsPerPixel = iterations;
+      result.settingSources["photons"] = iat.str() + ": Integrator \"sppm\" (photonsperiteration -1: numiterations per pixel)";
+      count = "photons = numiterations (" + std::to_string(iterations) + ") x the rendered image's pixels (render.photons_per_pixel)";
+    }
     r.maxRadius = float(radius);
     ip.markUsed("seed");
-    note(iat, "Integrator \"sppm\" mapped to tdpm's time-dependent photon method with photons = photonsperiteration x "
-              "numiterations = " + std::to_string(*r.photons) + " and max radius = radius (see docs/pbrt-import.md)");
+    note(iat, "Integrator \"sppm\" mapped to tdpm's time-dependent photon method with " + count +
+              " and max radius = radius (see docs/pbrt-import.md)");
   } else {
-    failAt(iat, "Integrator \"" + integ + "\" is not supported (path, volpath, sppm)");
+    failAt(iat, "Integrator \"" + integ + "\" is not supported (path, volpath, directlighting, bdpt, mlt, sppm)");
   }
   if (integrator_.given) ip.checkAllUsed();
   });
@@ -752,6 +783,31 @@ void Importer::worldBegin(const Loc& at) {
 
   gs_.ctm[0] = gs_.ctm[1] = Mat();
   coordSystems_["world"] = Mat();
+}
+
+// bdpt and mlt find every path pbrt's path tracer finds, and also light
+// from delta lights (point, spot, distant) through specular surfaces
+// (caustics), which tdpm's path tracer cannot. So: "time" (photon mapping,
+// which renders those caustics) when the scene has a delta light and a
+// mirror or glass surface, else "pathtrace" (the same image, unbiased).
+void Importer::chooseBidirectionalMethod() {
+  using LT = scene::LightDesc::Type;
+  using MT = scene::MaterialDesc::Type;
+  bool deltaLight = false, specular = false;
+  for (const auto& l : result.scene.lights) deltaLight |= l.type == LT::Point || l.type == LT::Spot || l.type == LT::Directional;
+  for (const auto& o : result.scene.objects) {
+    MT t = result.scene.materials.at(o.material).type;
+    specular |= t == MT::Mirror || t == MT::Dielectric;
+  }
+  const std::string integ = "Integrator \"" + integrator_.type + "\"";
+  if (deltaLight && specular) {
+    result.scene.render.method = "time";
+    note(bidirectionalAt_, integ + " mapped to tdpm's time-dependent photon method: the scene has a point, spot or "
+                           "distant light and a mirror or glass surface, whose caustics a path tracer cannot find");
+  } else {
+    result.scene.render.method = "pathtrace";
+    note(bidirectionalAt_, integ + " mapped to pathtrace (no delta light reaching a mirror or glass surface: the same image)");
+  }
 }
 
 void Importer::finish(const std::string& file) {
@@ -778,6 +834,7 @@ void Importer::finish(const std::string& file) {
     result.notes.push_back(film_.at.str() + ": Film: " + filmFactorWhat_ + " = " + fmtNum(imagingRatio_) +
                            "; the import scales every light by it");
   }
+  if (bidirectional_) chooseBidirectionalMethod();
   validateAsJson();
 }
 

@@ -63,6 +63,9 @@ struct ShapeRecord {
   int material = 0;
   std::optional<AreaLight> area;
   Loc at;
+  // pbrt's ReverseOrientation in effect for this shape (as written: an
+  // emitter's side and ShapeDesc::reverseOrientation derive from it).
+  bool reverseOrientation = false;
 };
 
 struct GraphicsState {
@@ -70,6 +73,7 @@ struct GraphicsState {
   unsigned active = 3;  // ActiveTransform: bit 0 StartTime, bit 1 EndTime
   int material = 0;
   std::optional<AreaLight> area;
+  bool reverseOrientation = false;  // toggled by ReverseOrientation; restored by AttributeEnd
 };
 
 struct StackEntry {
@@ -149,6 +153,10 @@ class Importer {
   void countTriangles(uint64_t n, const Loc& at, const std::string& what, bool add = true);
   // Camera "perspective" lensradius / focaldistance (pbrt_camera.cpp).
   void readThinLens(const ParamSet& ps);
+  // bdpt / mlt: pathtrace or time, by the scene's lights and surfaces (pbrt_import.cpp).
+  void chooseBidirectionalMethod();
+  bool bidirectional_ = false;
+  Loc bidirectionalAt_;
 
   GraphicsState gs_;
   std::vector<StackEntry> stack_;

@@ -445,7 +445,7 @@ void Importer::environmentLight(const ParamSet& ps, const Mat& M, const Loc& at)
 // ------------------------------------------------------------ shapes
 
 void Importer::shape(const std::string& type, ParamSet params, const Loc& at) {
-  ShapeRecord rec{type, std::move(params), {gs_.ctm[0], gs_.ctm[1]}, gs_.material, gs_.area, at};
+  ShapeRecord rec{type, std::move(params), {gs_.ctm[0], gs_.ctm[1]}, gs_.material, gs_.area, at, gs_.reverseOrientation};
   if (currentInstance_) {
     if (rec.area) failAt(at, "Shape: area lights inside an object definition are not supported (pbrt ignores them too)");
     currentInstance_->push_back(std::move(rec));
@@ -459,6 +459,8 @@ namespace {
 struct Geometry {
   bool sphere = false;
   float radius = 1;
+  // disk / cylinder: their ShapeDesc fields (type, radius, inner radius, height, z range, phi max)
+  std::optional<scene::ShapeDesc> quadric;
   std::vector<Vec3f> vertices;
   std::vector<uint32_t> indices;
   std::vector<Vec2f> uv;  // per vertex, when the file gives them (or a single bilinear patch's defaults)
@@ -533,6 +535,96 @@ static int readLoopLevels(const ParamSet& ps, size_t triangles, const Loc& at) {
   return levels;
 }
 
+// pbrt's disk (radius 1, innerradius 0, height 0, phimax 360) and cylinder
+// (radius 1, zmin -1, zmax 1, phimax 360), checked as pbrt would draw them:
+// an empty or inside-out surface is an error, not nothing.
+static scene::ShapeDesc readQuadric(const ShapeRecord& rec) {
+  const ParamSet& ps = rec.params;
+  const std::string what = "Shape \"" + rec.type + "\"";
+  scene::ShapeDesc q;
+  auto finite = [&](const char* name, double v) {
+    if (!std::isfinite(float(v))) ps.fail(*ps.find(name), std::string(name) + " must be a finite number");
+    return float(v);
+  };
+  double r = ps.getFloat("radius", 1);
+  if (!(r > 0)) failAt(rec.at, what + ": radius must be positive, got " + fmtNum(r));
+  q.radius = finite("radius", r);
+  double phimax = ps.getFloat("phimax", 360);
+  if (!(phimax > 0)) failAt(rec.at, what + ": phimax must be positive, got " + fmtNum(phimax));
+  q.phiMax = float(std::min(phimax, 360.0));  // pbrt clamps to [0, 360]
+  if (rec.type == "disk") {
+    q.type = scene::ShapeDesc::Type::Disk;
+    double inner = ps.getFloat("innerradius", 0);
+    if (!(inner >= 0)) failAt(rec.at, what + ": innerradius must be >= 0, got " + fmtNum(inner));
+    if (!(inner < r))
+      failAt(rec.at, what + ": innerradius " + fmtNum(inner) + " must be below radius " + fmtNum(r) + " (the disk would be empty)");
+    q.innerRadius = float(inner);
+    q.height = ps.has("height") ? finite("height", ps.getFloat("height", 0)) : 0.0f;
+  } else {
+    q.type = scene::ShapeDesc::Type::Cylinder;
+    double zmin = ps.getFloat("zmin", -1), zmax = ps.getFloat("zmax", 1);
+    if (!(zmin < zmax))
+      failAt(rec.at, what + ": zmin " + fmtNum(zmin) + " must be below zmax " + fmtNum(zmax) + " (the cylinder would be empty)");
+    q.zMin = ps.has("zmin") ? finite("zmin", zmin) : -1.0f;
+    q.zMax = ps.has("zmax") ? finite("zmax", zmax) : 1.0f;
+  }
+  return q;
+}
+
+// A bilinear patch p(u, v) = (1-u)(1-v) p00 + u(1-v) p10 + (1-u)v p01 + uv p11
+// is two triangles exactly when it is a parallelogram (twist
+// T = p00 - p10 - p01 + p11 = 0). Otherwise it is cut into an n x n grid of
+// cells, each two triangles with corners on the surface: in a cell the
+// surface is bilinear with twist T / n^2 and lies within |T| / (4 n^2) of
+// its triangles (the largest gap, at the cell's centre), so n is the
+// smallest with |T| / (4 n^2) <= kBilinearTolerance x the patch's longest
+// edge. |T| <= 2 x the longest edge, so n <= 23.
+constexpr double kBilinearTolerance = 1e-3;
+
+static int bilinearCells(Vec3f p00, Vec3f p10, Vec3f p01, Vec3f p11) {
+  double twist = length((p00 + p11) - (p10 + p01));
+  double edge = std::max({length(p10 - p00), length(p11 - p10), length(p01 - p11), length(p00 - p01), 1e-30f});
+  if (twist <= 1e-5 * edge) return 1;
+  return std::max(1, int(std::ceil(std::sqrt(twist / (4.0 * kBilinearTolerance * edge)))));
+}
+
+static void tessellateBilinear(const std::vector<Vec3f>& P, const std::vector<uint32_t>& idx, const Loc& at, Geometry& g) {
+  uint64_t triangles = 0;
+  for (size_t i = 0; i < idx.size(); i += 4) {
+    uint64_t n = uint64_t(bilinearCells(P[idx[i]], P[idx[i + 1]], P[idx[i + 2]], P[idx[i + 3]]));
+    triangles += 2 * n * n;
+  }
+  if (triangles > scene::limits::kMaxPbrtTriangles)
+    failAt(at, "Shape \"bilinearmesh\": its curved patches make " + std::to_string(triangles) +
+                   " triangles, more than tdpm's limit of " + std::to_string(scene::limits::kMaxPbrtTriangles));
+  const bool withUv = !g.uv.empty();
+  for (size_t i = 0; i < idx.size(); i += 4) {
+    const uint32_t c[4] = {idx[i], idx[i + 1], idx[i + 2], idx[i + 3]};  // p00, p10, p01, p11
+    int n = bilinearCells(P[c[0]], P[c[1]], P[c[2]], P[c[3]]);
+    if (n == 1) {
+      g.indices.insert(g.indices.end(), {c[0], c[1], c[3], c[0], c[3], c[2]});
+      continue;
+    }
+    // (n+1)^2 new vertices on the surface, row v = j / n, column u = k / n.
+    uint32_t base = uint32_t(g.vertices.size());
+    for (int j = 0; j <= n; ++j)
+      for (int k = 0; k <= n; ++k) {
+        float u = float(k) / float(n), v = float(j) / float(n);
+        float w[4] = {(1 - u) * (1 - v), u * (1 - v), (1 - u) * v, u * v};
+        g.vertices.push_back(P[c[0]] * w[0] + P[c[1]] * w[1] + P[c[2]] * w[2] + P[c[3]] * w[3]);
+        if (withUv) {
+          Vec2f t{0, 0};
+          for (int q = 0; q < 4; ++q) t = {t.x + w[q] * g.uv[c[q]].x, t.y + w[q] * g.uv[c[q]].y};
+          g.uv.push_back(t);
+        }
+      }
+    auto at2 = [&](int j, int k) { return base + uint32_t(j * (n + 1) + k); };
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < n; ++k)  // the corner patch's split: (00, 10, 11), (00, 11, 01)
+        g.indices.insert(g.indices.end(), {at2(j, k), at2(j, k + 1), at2(j + 1, k + 1), at2(j, k), at2(j + 1, k + 1), at2(j + 1, k)});
+  }
+}
+
 // `inputs` collects the files read (PLY meshes).
 static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(const std::string&)>& note, const std::string& mainDir,
                              std::vector<std::string>& inputs) {
@@ -546,6 +638,8 @@ static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(co
     if (zmin > -r || zmax < r || phimax < 360)
       failAt(rec.at, "Shape \"sphere\": partial spheres (zmin, zmax, phimax) are not supported");
     g.radius = float(r);
+  } else if (rec.type == "disk" || rec.type == "cylinder") {
+    g.quadric = readQuadric(rec);
   } else if (rec.type == "trianglemesh" || rec.type == "bilinearmesh") {
     bool bilinear = rec.type == "bilinearmesh";
     std::vector<Vec3f> P = readPoints(ps, "P", rec.at);
@@ -568,17 +662,7 @@ static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(co
     if (!bilinear) {
       g.indices = idx;
     } else {
-      // A bilinear patch (p00, p10, p01, p11) is flat and equal to two
-      // triangles exactly when it is a parallelogram.
-      for (size_t i = 0; i < idx.size(); i += 4) {
-        Vec3f p00 = P[idx[i]], p10 = P[idx[i + 1]], p01 = P[idx[i + 2]], p11 = P[idx[i + 3]];
-        Vec3f gap = (p00 + p11) - (p10 + p01);
-        float scale = std::max({length(p10 - p00), length(p01 - p00), 1e-30f});
-        if (length(gap) > 1e-5f * scale)
-          failAt(rec.at, "Shape \"bilinearmesh\": patch " + std::to_string(i / 4) +
-                             " is not a flat parallelogram; only those are exactly two triangles");
-        g.indices.insert(g.indices.end(), {idx[i], idx[i + 1], idx[i + 3], idx[i], idx[i + 3], idx[i + 2]});
-      }
+      tessellateBilinear(P, idx, rec.at, g);
     }
   } else if (rec.type == "plymesh") {
     std::string file = ps.getString("filename", "");
@@ -611,7 +695,7 @@ static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(co
     if (!problem.empty()) failAt(rec.at, "Shape \"loopsubdiv\": " + problem);
     note("Shape \"loopsubdiv\": shaded with the refined triangles' geometric normals, not pbrt's limit-surface normals");
   } else {
-    failAt(rec.at, "Shape \"" + rec.type + "\" is not supported (sphere, trianglemesh, bilinearmesh, plymesh, loopsubdiv)");
+    failAt(rec.at, "Shape \"" + rec.type + "\" is not supported (sphere, disk, cylinder, trianglemesh, bilinearmesh, plymesh, loopsubdiv)");
   }
   ps.checkAllUsed();
   return g;
@@ -741,7 +825,8 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
                  instanceAt.file.empty() ? "Shape \"" + rec.type + "\"" : "ObjectInstance (Shape \"" + rec.type + "\" at " + rec.at.str() + ")");
   const MaterialSlot& mat = materials_[size_t(rec.material)];
   if (rec.area) {
-    if (g.sphere) failAt(rec.at, "Shape \"sphere\" with an AreaLightSource: tdpm's area lights are rectangles");
+    if (g.sphere || g.quadric)
+      failAt(rec.at, "Shape \"" + rec.type + "\" with an AreaLightSource: tdpm's area lights are rectangles");
     if (g.loopLevels >= 0) {
       scene::LoopMesh m = scene::loopSubdivide(g.vertices, g.indices, g.loopLevels, scene::limits::kMaxSubdividedTriangles);
       emitAreaLight(rec, m.vertices, m.indices, ctm);
@@ -772,8 +857,31 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
         if (!nearlyUniform(k.scale)) failAt(rec.at, "Shape \"sphere\" under a non-uniform scale (an ellipsoid) is not supported");
       o.motion = plan.keys;
     }
+    // pbrt flips an analytic shape's normal when its transform swaps
+    // handedness (so that it is cross(dp/du, dp/dv) in world space), and
+    // again for ReverseOrientation; tdpm's sphere normal is always outward.
+    // (tdpm's own x mirror is not in ctm: a mirror keeps sides.)
+    o.shape.reverseOrientation = rec.reverseOrientation != (ctm[0].det3() < 0);
+  } else if (g.quadric) {
+    if (mat.checker) failAt(rec.at, "Shape \"" + rec.type + "\": a checkerboard on a disk or cylinder is not supported (tdpm's checker is not in (u, v))");
+    o.shape = *g.quadric;
+    if (!plan.moving) {
+      std::string degenerate = scaleProblem(plan.still);
+      if (!degenerate.empty()) failAt(rec.at, "Shape \"" + rec.type + "\": its transform is unusable: " + degenerate);
+      std::optional<Pose> p = decompose(plan.still);
+      if (!p) failAt(rec.at, "Shape \"" + rec.type + "\" under shear or a scale along rotated axes is not supported (tdpm's placements are translate x rotate x scale)");
+      o.placement.translate = p->translate;
+      o.placement.rotate = canonicalRotation(p->rotate);
+      o.placement.scale = p->scale;
+    } else {
+      o.motion = plan.keys;
+    }
+    o.shape.reverseOrientation = rec.reverseOrientation != (ctm[0].det3() < 0);  // as for the sphere
   } else {
     o.shape.type = scene::ShapeDesc::Type::Mesh;
+    // A triangle's normal: (p1 - p0) x (p2 - p0), transformed as a normal
+    // (the winding is kept through mirrors below), then ReverseOrientation.
+    o.shape.reverseOrientation = rec.reverseOrientation;
     o.shape.indices = g.indices;
     o.shape.loopLevels = g.loopLevels;  // placements are affine: refining after baking them is exact
     if (mat.checker) {
@@ -855,6 +963,7 @@ void Importer::emitAreaLight(const ShapeRecord& rec, const std::vector<Vec3f>& v
                    dot(tri[0], tri[1]) > 0;
   if (!rectangle) failAt(rec.at, what + ": the shape is not a rectangle of two triangles facing the same way");
   Vec3f n = normalize(tri[0]);
+  if (rec.reverseOrientation) n = -n;  // pbrt: the emitting side follows the flipped normal
   Vec3f x = e1 / l1, y = -n, z = cross(x, y);
   double R[3][3] = {{x.x, y.x, z.x}, {x.y, y.y, z.y}, {x.z, y.z, z.z}};
   Rgb L = nonNegative(ps, "L", color(ps, "L", Rgb(1.0f))) * lightScale(ps);

@@ -100,6 +100,7 @@ std::map<std::string, std::string> renderSettings(const RenderOptions& o, int wi
   // keeps the fingerprint it had before they existed.
   if (o.passExtraSamples > 0 && o.passSampleCap > 1)
     s["extra_samples"] = floatText(o.passExtraSamples) + " (cap " + std::to_string(o.passSampleCap) + ")";
+  if (o.directOnly) s["direct_only"] = "yes";  // likewise: only when on
   return s;
 }
 

@@ -50,6 +50,8 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
   // it finds: it is the BSDF half of that vertex's MIS pair, without which
   // direct light from area lights would lose its BSDF-sampled share (all of
   // it for max_depth 1). pbrt's maxdepth counts the same way.
+  // directOnly_: the first non-delta vertex is the last to scatter.
+  int lastDepth = maxDepth_;
   for (int depth = 0;; ++depth) {
     Hit hit;
     if (!scene_.intersect(origin, dir, std::numeric_limits<float>::infinity(), time01, hit)) {
@@ -68,7 +70,7 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
       }
       break;  // emitters do not reflect
     }
-    if (depth == maxDepth_) break;
+    if (depth == lastDepth) break;
     const Material& mat = resolveMaterial(scene_.materials.data(), scene_.objects[hit.object].material, hit.p, -dir);
     ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
 
@@ -83,6 +85,7 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
     if (guide_ && !mat.isDeltaOnly() && diffuseVertices < kGuidedDiffuseVertices)
       guide_->conesAt(mat, hit.p, ctx.frame.n, cones);
     if (!mat.isDeltaOnly()) ++diffuseVertices;
+    if (directOnly_ && !mat.isDeltaOnly()) lastDepth = std::min(lastDepth, depth + 1);
 
     // ---- next-event estimation ----
     if (!mat.isDeltaOnly())

@@ -20,8 +20,9 @@ namespace tdpm {
 class PathTracer {
  public:
   // guide: null or disabled for plain BSDF sampling; must outlive the tracer.
-  PathTracer(const Scene& scene, int maxDepth, const CausticGuide* guide = nullptr)
-      : scene_(scene), maxDepth_(maxDepth), guide_(guide && guide->enabled() ? guide : nullptr) {}
+  // directOnly: RenderOptions::directOnly (pbrt's directlighting).
+  PathTracer(const Scene& scene, int maxDepth, const CausticGuide* guide = nullptr, bool directOnly = false)
+      : scene_(scene), maxDepth_(maxDepth), guide_(guide && guide->enabled() ? guide : nullptr), directOnly_(directOnly) {}
 
   // Per-thread scratch: none at present (the guide's k-NN keeps its few
   // candidates on the stack); kept so that callers need not change.
@@ -49,6 +50,7 @@ class PathTracer {
   const Scene& scene_;
   int maxDepth_;
   const CausticGuide* guide_;
+  bool directOnly_;
 };
 
 }  // namespace tdpm

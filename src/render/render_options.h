@@ -33,6 +33,12 @@ struct RenderOptions {
   FilterKind filter = FilterKind::Box;       // sampling/filter.h
   float filterRadius = 0.0f;                 // pixels; 0: the kind's default
   int maxDepth = 16;
+  // Path tracing only: direct light only, as pbrt's "directlighting"
+  // integrator. A path stops after its first non-delta vertex (next-event
+  // estimation there, and its BSDF-sampled ray traced for the emission it
+  // meets, the MIS pair); delta (mirror, glass) vertices before it still
+  // scatter, up to maxDepth vertices in all.
+  bool directOnly = false;
   // Path tracing: the share (at most) of the first two diffuse vertices'
   // continuation samples aimed where caustic photons came from
   // (render/caustic_guide.h; 0 samples the BSDF alone), and the photons

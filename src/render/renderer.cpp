@@ -423,7 +423,7 @@ void addMapCounts(RenderStats& st, const EstimateCounts& c) {
 void renderPathTraced(const Scene& scene, const RenderOptions& opt, const SamplingPlan& plan, const Progress& progress,
                       RenderStats& st, Film& film) {
   CausticGuide guide = buildCausticGuide(scene, opt, progress, st);
-  PathTracer pt(scene, opt.maxDepth, &guide);
+  PathTracer pt(scene, opt.maxDepth, &guide, opt.directOnly);
   renderPixels(scene, pt, plan, "render", progress, film);
   st.guideCellsFilled = guide.cacheFilled();
 }

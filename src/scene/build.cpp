@@ -1,4 +1,5 @@
-// scene/build.cpp — SceneDescription -> Scene: tessellates quads and boxes,
+// scene/build.cpp — SceneDescription -> Scene: tessellates quads and boxes
+// (spheres, disks and cylinders stay analytic),
 // resamples motion into time steps, uploads geometry, derives light
 // constants, swept bounds and the scene's scale.
 #include <algorithm>
@@ -67,6 +68,20 @@ uint32_t addMesh(EmbreeScene& embree, const Motion& m, const TriangleMesh& mesh)
 
 // Uniform scale factor of a step matrix (spheres require uniform scale).
 float uniformScale(const Affine3f& m) { return std::cbrt(std::fabs(m.determinant3())); }
+
+// The disk or cylinder of a shape (parse.cpp and the pbrt import checked
+// the radii, heights and phiMax).
+Quadric toQuadric(const ShapeDesc& d) {
+  Quadric q;
+  q.kind = d.type == ShapeDesc::Type::Disk ? Quadric::Kind::Disk : Quadric::Kind::Cylinder;
+  q.radius = d.radius;
+  q.innerRadius = d.innerRadius;
+  q.height = d.height;
+  q.zMin = d.zMin;
+  q.zMax = d.zMax;
+  q.phiMax = std::min(d.phiMax, 360.0f) * kPi / 180.0f;
+  return q;
+}
 
 Material toMaterial(const scene::MaterialDesc& d) {
   Material m;
@@ -177,6 +192,7 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
     SceneObject o;
     o.name = od.name;
     o.material = od.material;
+    o.reverseOrientation = od.shape.reverseOrientation;
     o.motion = makeMotion(od.placement, od.motion, s.shutter);
     if (od.shape.type == ShapeDesc::Type::Sphere) {
       o.kind = SceneObject::Kind::Sphere;
@@ -190,6 +206,13 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
       }
       s.geometryOwner_.push_back(int32_t(s.objects.size()));
       uint32_t id = s.embree_.addSphere(centres, radii);
+      TDPM_ASSERT(id + 1 == s.geometryOwner_.size(), "geometry ids out of order");
+    } else if (od.shape.type == ShapeDesc::Type::Disk || od.shape.type == ShapeDesc::Type::Cylinder) {
+      o.kind = SceneObject::Kind::Quadric;
+      o.quadric = toQuadric(od.shape);
+      o.objectBounds = quadricBounds(o.quadric);
+      s.geometryOwner_.push_back(int32_t(s.objects.size()));
+      uint32_t id = s.embree_.addQuadric(o.quadric, o.motion);
       TDPM_ASSERT(id + 1 == s.geometryOwner_.size(), "geometry ids out of order");
     } else {
       TriangleMesh mesh;

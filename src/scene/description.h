@@ -63,9 +63,21 @@ struct MaterialDesc {
 };
 
 struct ShapeDesc {
-  enum class Type { Sphere, Quad, Box, Mesh };
+  enum class Type { Sphere, Quad, Box, Mesh, Disk, Cylinder };
   Type type = Type::Sphere;
-  float radius = 1.0f;         // sphere, centred at the local origin
+  float radius = 1.0f;         // sphere, centred at the local origin; disk, cylinder
+  // Disk (z = height, innerRadius <= r <= radius) and cylinder (r = radius,
+  // zMin <= z <= zMax) in pbrt's frame, cut to phi in [0, phiMax] (degrees,
+  // (0, 360]); scene/quadric.h.
+  float innerRadius = 0.0f;
+  float height = 0.0f;
+  float zMin = -1.0f, zMax = 1.0f;
+  float phiMax = 360.0f;
+  // Flip the surface's normal (pbrt's ReverseOrientation): which side is
+  // outside for glass, and the emitting side of an emitter. Without it the
+  // normal is the shape's own (sphere, cylinder: outward; disk: +z; quad:
+  // +y; box: outward; mesh: (p1 - p0) x (p2 - p0)), transformed as a normal.
+  bool reverseOrientation = false;
   Vec3f size{1, 1, 1};         // quad: size.x by size.z in the local x-z plane,
                                // normal +y; box: full extents, centred
   std::string meshFile;        // mesh: path as resolved against the scene dir
@@ -145,9 +157,14 @@ struct RenderSettings {
   std::optional<std::string> filter;  // box | gaussian
   std::optional<float> filterRadius;  // pixels, (0, 16]
   std::optional<int> maxDepth;        // path vertices, >= 1
+  std::optional<bool> directOnly;     // pathtrace: direct light only (RenderOptions::directOnly)
   std::optional<float> exposure;      // PNG preview: stops
   // photon methods
   std::optional<int64_t> photons;         // caustic photons stored, >= 0
+  // Caustic photons per pixel of the rendered image (pbrt's sppm
+  // photonsperiteration -1): photons = this x width x height, the
+  // resolution after --resolution. Not with `photons`.
+  std::optional<int64_t> photonsPerPixel;
   std::optional<int64_t> globalPhotons;   // global photons stored, >= 0
   std::optional<int> frames;              // accumulation, >= 1
   std::optional<std::string> search;      // twopass | 4d

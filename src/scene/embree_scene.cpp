@@ -1,5 +1,6 @@
 // scene/embree_scene.cpp — Embree 3 device, geometry in layers (still
-// meshes, spheres, moving meshes with vertices per time step), and
+// meshes, spheres, moving meshes with vertices per time step, disks and
+// cylinders as user geometry), and
 // single-ray queries (rtcIntersect1 / rtcOccluded1) that visit a layer only
 // where its bounds are.
 #include "scene/embree_scene.h"
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -73,6 +75,58 @@ uint32_t attachTriangles(RTCDevice device, RTCScene scene, unsigned steps, size_
   return id;
 }
 
+// A disk or cylinder as Embree user geometry: the callbacks below take a
+// ray to object space with the placement's inverse at the ray's time (the
+// blended steps of motion/motion.h, the same blend Embree applies to moving
+// vertices), so the surface is exact under any affine placement.
+struct QuadricRecord {
+  Quadric shape;
+  Motion motion;
+  Affine3f stillInverse;  // world-to-object, when still
+};
+
+void quadricBoundsCallback(const RTCBoundsFunctionArguments* args) {
+  const auto* q = static_cast<const QuadricRecord*>(args->geometryUserPtr);
+  Bounds3f b = transformBounds(q->motion.step(int(args->timeStep)), quadricBounds(q->shape));
+  // Pad past float rounding of the object-space test (a hit on the rim
+  // must not be culled by the box).
+  float size = std::max({std::fabs(b.lo.x), std::fabs(b.lo.y), std::fabs(b.lo.z), std::fabs(b.hi.x), std::fabs(b.hi.y),
+                         std::fabs(b.hi.z)});
+  Vec3f pad(1e-5f * size + 1e-6f);
+  RTCBounds* out = args->bounds_o;
+  out->lower_x = b.lo.x - pad.x; out->lower_y = b.lo.y - pad.y; out->lower_z = b.lo.z - pad.z;
+  out->upper_x = b.hi.x + pad.x; out->upper_y = b.hi.y + pad.y; out->upper_z = b.hi.z + pad.z;
+}
+
+// The ray in object space: rtcIntersect1 / rtcOccluded1 call with N = 1,
+// where the ray packet is a plain RTCRay(Hit).
+bool quadricRayHit(const QuadricRecord& q, const RTCRay& r, float& s) {
+  Affine3f inv = q.motion.moving() ? q.motion.atNormalized(r.time).inverse() : q.stillInverse;
+  Vec3f o = inv.point({r.org_x, r.org_y, r.org_z}), d = inv.vector({r.dir_x, r.dir_y, r.dir_z});
+  return intersectQuadric(q.shape, o, d, r.tnear, r.tfar, s);
+}
+
+void quadricIntersectCallback(const RTCIntersectFunctionNArguments* args) {
+  if (args->N != 1 || !args->valid[0]) return;
+  auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+  float s;
+  if (!quadricRayHit(*static_cast<const QuadricRecord*>(args->geometryUserPtr), rh->ray, s)) return;
+  rh->ray.tfar = s;
+  rh->hit.u = rh->hit.v = 0.0f;
+  rh->hit.Ng_x = 0.0f; rh->hit.Ng_y = 0.0f; rh->hit.Ng_z = 1.0f;  // unused: scene.cpp makes the normal
+  rh->hit.primID = args->primID;
+  rh->hit.geomID = args->geomID;
+  rh->hit.instID[0] = args->context->instID[0];
+}
+
+void quadricOccludedCallback(const RTCOccludedFunctionNArguments* args) {
+  if (args->N != 1 || !args->valid[0]) return;
+  auto* r = reinterpret_cast<RTCRay*>(args->ray);
+  float s;
+  if (quadricRayHit(*static_cast<const QuadricRecord*>(args->geometryUserPtr), *r, s))
+    r->tfar = -std::numeric_limits<float>::infinity();
+}
+
 }  // namespace
 
 // Embree pays a fixed price for every acceleration structure a ray visits,
@@ -88,7 +142,7 @@ uint32_t attachTriangles(RTCDevice device, RTCScene scene, unsigned steps, size_
 // to search meets the layer's bounds (each geometry's, padded, or their
 // union when there are many), which few rays do.
 struct EmbreeScene::Impl {
-  enum LayerId { kStillMeshes = 0, kSpheres, kMovingMeshes, kLayers };
+  enum LayerId { kStillMeshes = 0, kSpheres, kMovingMeshes, kQuadrics, kLayers };
   static constexpr size_t kMaxListedBounds = 8;  // beyond: one union box
 
   struct Layer {
@@ -108,8 +162,9 @@ struct EmbreeScene::Impl {
 
   RTCDevice device = nullptr;
   Layer layers[kLayers];
-  bool gated = false;                // a sphere or moving layer holds geometry
+  bool gated = false;                // a sphere, moving or quadric layer holds geometry
   uint32_t nextId = 0;
+  std::vector<std::unique_ptr<QuadricRecord>> quadrics;  // the user data of the quadric layer's geometry
 
   void check(const char* what) const {
     RTCError e = rtcGetDeviceError(device);
@@ -198,6 +253,28 @@ uint32_t EmbreeScene::addSphere(const std::vector<Vec3f>& centres, const std::ve
   rtcReleaseGeometry(g);
   impl_->check("add a sphere");
   return impl_->record(Impl::kSpheres, e, swept);
+}
+
+uint32_t EmbreeScene::addQuadric(const Quadric& shape, const Motion& motion) {
+  auto rec = std::make_unique<QuadricRecord>();
+  rec->shape = shape;
+  rec->motion = motion;
+  rec->stillInverse = motion.step(0).inverse();
+  RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_USER);
+  impl_->check("create a disk or cylinder");
+  rtcSetGeometryUserPrimitiveCount(g, 1);
+  if (motion.stepCount() > 1) rtcSetGeometryTimeStepCount(g, unsigned(motion.stepCount()));
+  rtcSetGeometryUserData(g, rec.get());
+  rtcSetGeometryBoundsFunction(g, quadricBoundsCallback, rec.get());
+  rtcSetGeometryIntersectFunction(g, quadricIntersectCallback);
+  rtcSetGeometryOccludedFunction(g, quadricOccludedCallback);
+  rtcCommitGeometry(g);
+  uint32_t e = rtcAttachGeometry(impl_->layers[Impl::kQuadrics].scene, g);
+  rtcReleaseGeometry(g);
+  impl_->check("add a disk or cylinder");
+  Bounds3f swept = motion.sweptBounds(quadricBounds(shape));
+  impl_->quadrics.push_back(std::move(rec));
+  return impl_->record(Impl::kQuadrics, e, swept);
 }
 
 void EmbreeScene::commit() {

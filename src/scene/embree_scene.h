@@ -4,7 +4,7 @@
 // equally spaced time steps, from which the vertices of every step are
 // made (Embree blends them linearly in ray time, the blend
 // motion/Motion::atNormalized defines). Geometry is kept in layers, each
-// its own Embree scene, and a ray visits the sphere and moving layers only
+// its own Embree scene, and a ray visits the sphere, quadric and moving layers only
 // where their bounds are (embree_scene.cpp says why). Rays come back as
 // raw hits. Device and scene handles are owned here.
 #pragma once
@@ -14,6 +14,8 @@
 
 #include "math/transform.h"
 #include "math/vec.h"
+#include "motion/motion.h"
+#include "scene/quadric.h"
 
 namespace tdpm {
 
@@ -37,6 +39,9 @@ class EmbreeScene {
                               const std::vector<Affine3f>& steps);
   // One sphere: centre and radius per time step.
   uint32_t addSphere(const std::vector<Vec3f>& centres, const std::vector<float>& radii);
+  // One disk or cylinder (scene/quadric.h) under `motion` (still or moving):
+  // Embree user geometry whose callbacks take each ray into object space.
+  uint32_t addQuadric(const Quadric& shape, const Motion& motion);
   void commit();
 
   // time01: normalised shutter time in [0,1].

@@ -253,7 +253,16 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
         if (s.loopLevels >= 0) j["shape"]["subdivision"] = Json{{"scheme", "loop"}, {"levels", s.loopLevels}};
         break;
       }
+      case scene::ShapeDesc::Type::Disk:
+        j["shape"] = Json{{"type", "disk"}, {"radius", num(s.radius)}, {"inner_radius", num(s.innerRadius)},
+                          {"height", num(s.height)}, {"phi_max", num(s.phiMax)}};
+        break;
+      case scene::ShapeDesc::Type::Cylinder:
+        j["shape"] = Json{{"type", "cylinder"}, {"radius", num(s.radius)}, {"z_min", num(s.zMin)}, {"z_max", num(s.zMax)},
+                          {"phi_max", num(s.phiMax)}};
+        break;
     }
+    if (s.reverseOrientation) j["shape"]["reverse_orientation"] = true;
     j["material"] = sc.materials.at(o.material).name;
     Json t = transform(o.placement);
     if (!t.empty()) j["transform"] = t;
@@ -309,8 +318,10 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
   if (r.contrast) render["contrast"] = num(*r.contrast);
   if (r.seed) render["seed"] = *r.seed;
   if (r.maxDepth) render["max_depth"] = *r.maxDepth;
+  if (r.directOnly) render["direct_only"] = *r.directOnly;
   if (r.exposure) render["exposure"] = num(*r.exposure);
   if (r.photons) render["photons"] = *r.photons;
+  if (r.photonsPerPixel) render["photons_per_pixel"] = *r.photonsPerPixel;
   if (r.globalPhotons) render["global_photons"] = *r.globalPhotons;
   if (r.frames) render["frames"] = *r.frames;
   if (r.search) render["search"] = *r.search;

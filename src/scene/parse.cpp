@@ -598,19 +598,47 @@ void readMesh(const Node& n, const std::string& sceneDir, ShapeDesc* shape) {
   if (n.has("subdivision")) readSubdivision(n.member("subdivision"), shape);
 }
 
+// Disk: radius > 0, 0 <= inner_radius < radius, any height; cylinder:
+// radius > 0, z_min < z_max; both phi_max in (0, 360] (pbrt's checks, plus
+// what makes the surface empty: pbrt would render nothing there).
+void readQuadric(const Node& n, ShapeDesc* s) {
+  if (n.has("radius")) s->radius = readPositive(n.member("radius"), "radius");
+  if (s->type == ShapeDesc::Type::Disk) {
+    if (n.has("inner_radius")) {
+      Node in = n.member("inner_radius");
+      s->innerRadius = in.number();
+      in.require(s->innerRadius >= 0, "inner_radius must be >= 0, got " + fmt(s->innerRadius));
+      in.require(s->innerRadius < s->radius, "inner_radius " + fmt(s->innerRadius) + " must be below radius " + fmt(s->radius) +
+                                                  " (the disk would be empty)");
+    }
+    if (n.has("height")) s->height = n.member("height").number();
+    checkPoint(n, {s->radius, s->radius, s->height}, "disk extent");
+  } else {
+    if (n.has("z_min")) s->zMin = n.member("z_min").number();
+    if (n.has("z_max")) s->zMax = n.member("z_max").number();
+    n.require(s->zMin < s->zMax, "z_min " + fmt(s->zMin) + " must be below z_max " + fmt(s->zMax) + " (the cylinder would be empty)");
+    checkPoint(n, {s->radius, std::fabs(s->zMin), std::fabs(s->zMax)}, "cylinder extent");
+  }
+  if (n.has("phi_max")) {
+    Node p = n.member("phi_max");
+    s->phiMax = p.number();
+    p.require(s->phiMax > 0 && s->phiMax <= 360, "phi_max must be in (0, 360] degrees, got " + fmt(s->phiMax));
+  }
+}
+
 ShapeDesc readShape(const Node& n, const std::string& sceneDir) {
   n.requireObject();
-  std::string type = n.required("type").choice({"sphere", "quad", "box", "mesh"}, "shape type");
+  std::string type = n.required("type").choice({"sphere", "quad", "box", "mesh", "disk", "cylinder"}, "shape type");
   ShapeDesc s;
   if (type == "sphere") {
-    n.expectObject({"type", "radius"});
+    n.expectObject({"type", "radius", "reverse_orientation"});
     s.type = ShapeDesc::Type::Sphere;
     if (n.has("radius")) {
       s.radius = readPositive(n.member("radius"), "radius");
       checkPoint(n.member("radius"), Vec3f(s.radius), "radius");
     }
   } else if (type == "quad") {
-    n.expectObject({"type", "size"});
+    n.expectObject({"type", "size", "reverse_orientation"});
     s.type = ShapeDesc::Type::Quad;
     if (n.has("size")) {
       Node sz = n.member("size");
@@ -620,7 +648,7 @@ ShapeDesc readShape(const Node& n, const std::string& sceneDir) {
       checkPoint(sz, s.size * 0.5f, "half size");
     }
   } else if (type == "box") {
-    n.expectObject({"type", "size"});
+    n.expectObject({"type", "size", "reverse_orientation"});
     s.type = ShapeDesc::Type::Box;
     if (n.has("size")) {
       Node sz = n.member("size");
@@ -629,10 +657,23 @@ ShapeDesc readShape(const Node& n, const std::string& sceneDir) {
                  "size must be positive in every dimension, got " + formatVec(s.size));
       checkPoint(sz, s.size * 0.5f, "half size");
     }
+  } else if (type == "disk") {
+    n.expectObject({"type", "radius", "inner_radius", "height", "phi_max", "reverse_orientation"});
+    s.type = ShapeDesc::Type::Disk;
+    readQuadric(n, &s);
+  } else if (type == "cylinder") {
+    n.expectObject({"type", "radius", "z_min", "z_max", "phi_max", "reverse_orientation"});
+    s.type = ShapeDesc::Type::Cylinder;
+    readQuadric(n, &s);
   } else {
-    n.expectObject({"type", "file", "subdivision"});
+    n.expectObject({"type", "file", "subdivision", "reverse_orientation"});
     s.type = ShapeDesc::Type::Mesh;
     readMesh(n, sceneDir, &s);
+  }
+  if (n.has("reverse_orientation")) {
+    Node r = n.member("reverse_orientation");
+    r.require(r.json().is_boolean(), "expected true or false");
+    s.reverseOrientation = r.json().get<bool>();
   }
   return s;
 }
@@ -647,6 +688,8 @@ Bounds3f objectBounds(const ShapeDesc& shape) {
     case ShapeDesc::Type::Quad: b.extend({-0.5f * shape.size.x, 0, -0.5f * shape.size.z}); b.extend({0.5f * shape.size.x, 0, 0.5f * shape.size.z}); break;
     case ShapeDesc::Type::Box: b.extend(shape.size * -0.5f); b.extend(shape.size * 0.5f); break;
     case ShapeDesc::Type::Mesh: for (Vec3f v : shape.vertices) b.extend(v); break;
+    case ShapeDesc::Type::Disk: b.extend({-shape.radius, -shape.radius, shape.height}); b.extend({shape.radius, shape.radius, shape.height}); break;
+    case ShapeDesc::Type::Cylinder: b.extend({-shape.radius, -shape.radius, shape.zMin}); b.extend({shape.radius, shape.radius, shape.zMax}); break;
   }
   return b;
 }
@@ -865,7 +908,8 @@ const std::vector<std::string> kTimeKernels = {"uniform", "epanechnikov"};
 RenderSettings readRender(const Node& n, float shutterLength) {
   n.expectObject({"method", "spp", "max_spp", "contrast", "seed", "max_depth", "exposure", "photons", "global_photons",
                   "frames", "search", "k", "fraction", "kappa", "max_radius", "max_dt", "kernel_space", "kernel_time",
-                  "gather", "sampler", "filter", "filter_radius", "progressive", "passes", "time_limit"});
+                  "gather", "sampler", "filter", "filter_radius", "progressive", "passes", "time_limit", "direct_only",
+                  "photons_per_pixel"});
   RenderSettings r;
   if (n.has("method")) r.method = n.member("method").choice(renderMethodNames(), "render method");
   if (n.has("spp")) r.spp = readCount(n.member("spp"), "spp", limits::kSpp);
@@ -899,6 +943,21 @@ RenderSettings readRender(const Node& n, float shutterLength) {
   }
   if (n.has("passes")) r.passes = readCount(n.member("passes"), "passes", limits::kPasses);
   if (n.has("time_limit")) r.timeLimit = readFloatInRange(n.member("time_limit"), "time_limit", limits::kTimeLimit);
+  if (n.has("direct_only")) {
+    Node p = n.member("direct_only");
+    p.require(p.json().is_boolean(), "expected true or false");
+    r.directOnly = p.json().get<bool>();
+    // Required rather than implied: a file that says direct_only and no
+    // method would otherwise render with the default method, not direct light.
+    p.require(!*r.directOnly || (r.method && parseRenderMethod(*r.method) == RenderMethod::PathTrace),
+              "direct_only is a pathtrace setting: it needs render.method \"pathtrace\"" +
+                  (r.method ? ", not \"" + *r.method + "\"" : std::string(" (none is given)")));
+  }
+  if (n.has("photons_per_pixel")) {
+    Node p = n.member("photons_per_pixel");
+    p.require(!r.photons, "give photons or photons_per_pixel, not both");
+    r.photonsPerPixel = readInRange(p, "photons_per_pixel", {1, limits::kPhotons.hi});
+  }
   return r;
 }
 

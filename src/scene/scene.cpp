@@ -7,6 +7,15 @@
 
 namespace tdpm {
 
+namespace {
+// Normals transform by the inverse transpose: inv^T n, given inv.
+Vec3f inverseTransposeTimes(const Affine3f& inv, Vec3f n) {
+  return {inv.m[0][0] * n.x + inv.m[1][0] * n.y + inv.m[2][0] * n.z,
+          inv.m[0][1] * n.x + inv.m[1][1] * n.y + inv.m[2][1] * n.z,
+          inv.m[0][2] * n.x + inv.m[1][2] * n.y + inv.m[2][2] * n.z};
+}
+}  // namespace
+
 float Scene::epsilon(Vec3f p) const {
   // Relative to both the point's magnitude (float spacing grows with it) and
   // the scene's size, so a scene scaled by 1e-3 or 1e3 behaves the same.
@@ -52,22 +61,19 @@ bool Scene::intersect(Vec3f o, Vec3f d, float tFar, float time01, Hit& hit) cons
   const SceneObject& obj = objects[size_t(owner)];
   if (!obj.motion.moving()) {
     // Static: world-space normals and the inverse placement were made once.
-    hit.n = obj.kind == SceneObject::Kind::Sphere ? normalize(hit.p - obj.worldCentre) : obj.worldNormals[raw.primitiveId];
     hit.localP = obj.inversePlacement.point(hit.p);
-    return true;
-  }
-  Affine3f m = obj.motion.atNormalized(time01);
-  Affine3f inv = m.inverse();  // once: for the object-space point and the normal
-  if (obj.kind == SceneObject::Kind::Sphere) {
-    hit.n = normalize(hit.p - m.point({0, 0, 0}));
+    if (obj.kind == SceneObject::Kind::Sphere) hit.n = normalize(hit.p - obj.worldCentre);
+    else if (obj.kind == SceneObject::Kind::Triangles) hit.n = obj.worldNormals[raw.primitiveId];
+    else hit.n = normalize(inverseTransposeTimes(obj.inversePlacement, quadricNormal(obj.quadric, hit.localP)));
   } else {
-    // Normals transform by the inverse transpose.
-    Vec3f n = obj.faceNormals[raw.primitiveId];
-    hit.n = normalize(Vec3f{inv.m[0][0] * n.x + inv.m[1][0] * n.y + inv.m[2][0] * n.z,
-                            inv.m[0][1] * n.x + inv.m[1][1] * n.y + inv.m[2][1] * n.z,
-                            inv.m[0][2] * n.x + inv.m[1][2] * n.y + inv.m[2][2] * n.z});
+    Affine3f m = obj.motion.atNormalized(time01);
+    Affine3f inv = m.inverse();  // once: for the object-space point and the normal
+    hit.localP = inv.point(hit.p);
+    if (obj.kind == SceneObject::Kind::Sphere) hit.n = normalize(hit.p - m.point({0, 0, 0}));
+    else if (obj.kind == SceneObject::Kind::Triangles) hit.n = normalize(inverseTransposeTimes(inv, obj.faceNormals[raw.primitiveId]));
+    else hit.n = normalize(inverseTransposeTimes(inv, quadricNormal(obj.quadric, hit.localP)));
   }
-  hit.localP = inv.point(hit.p);
+  if (obj.reverseOrientation) hit.n = -hit.n;
   return true;
 }
 

@@ -14,13 +14,16 @@
 #include "scene/embree_scene.h"
 #include "scene/light.h"
 #include "scene/material.h"
+#include "scene/quadric.h"
 
 namespace tdpm {
 
 struct SceneObject {
-  enum class Kind : uint8_t { Sphere, Triangles };
+  enum class Kind : uint8_t { Sphere, Triangles, Quadric };
   std::string name;
   Kind kind = Kind::Triangles;
+  bool reverseOrientation = false;  // hit normals flipped (ShapeDesc::reverseOrientation)
+  Quadric quadric;                  // Kind::Quadric: the disk or cylinder
   uint32_t material = 0;
   Motion motion;                    // object-to-world over the shutter
   Bounds3f objectBounds;            // object space
