@@ -37,6 +37,10 @@ class EmbreeScene {
                               const std::vector<Affine3f>& steps);
   // One sphere: centre and radius per time step.
   uint32_t addSphere(const std::vector<Vec3f>& centres, const std::vector<float>& radii);
+  // One disc (a disk area light): centre, unit normal and radius per time
+  // step, in the sphere layer (Embree's oriented disc points).
+  uint32_t addOrientedDisc(const std::vector<Vec3f>& centres, const std::vector<Vec3f>& normals,
+                           const std::vector<float>& radii);
   void commit();
 
   // time01: normalised shutter time in [0,1].
