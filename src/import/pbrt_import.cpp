@@ -488,7 +488,8 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
       }
     }
   } else if (s == "ReverseOrientation") {
-    failAt(at, "ReverseOrientation is not supported (tdpm cannot flip a sphere's or an emitter's orientation)");
+    // Only emitters have a side in tdpm (its BSDFs shade either side alike).
+    gs_.reverseOrientation = !gs_.reverseOrientation;
   } else {
     failAt(at, "statement " + s + " is not supported by tdpm's pbrt import (see docs/pbrt-import.md)");
   }

@@ -62,6 +62,7 @@ struct ShapeRecord {
   int material = 0;
   std::optional<AreaLight> area;
   Loc at;
+  bool reverseOrientation = false;  // pbrt's ReverseOrientation (emitters: which side emits)
 };
 
 struct GraphicsState {
@@ -69,6 +70,7 @@ struct GraphicsState {
   unsigned active = 3;  // ActiveTransform: bit 0 StartTime, bit 1 EndTime
   int material = 0;
   std::optional<AreaLight> area;
+  bool reverseOrientation = false;  // toggled by ReverseOrientation, saved by AttributeBegin
 };
 
 struct StackEntry {
@@ -121,6 +123,11 @@ class Importer {
 
   // mapping
   void emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& instanceAt);
+  // Sphere and disk emitters (pbrt_mapping.cpp); the radiance and power
+  // shared by every emitter; the light pushed with its material note.
+  void emitRoundLight(const ShapeRecord& rec, const Mat ctm[2]);
+  Rgb areaLightL(const ShapeRecord& rec, double area, bool twoSided);
+  void pushAreaLight(const ShapeRecord& rec, scene::LightDesc l);
   void emitAreaLight(const ShapeRecord& rec, const std::vector<Vec3f>& verts, const std::vector<uint32_t>& idx,
                      const Mat ctm[2]);
   struct MotionPlan {
