@@ -18,6 +18,7 @@
 #include "core/error.h"
 #include "core/rng.h"
 #include "import/pbrt_import.h"
+#include "render/fingerprint.h"
 #include "scene/json_writer.h"
 #include "scene/parse.h"
 #include "cli_harness.h"
@@ -424,4 +425,16 @@ TEST_CASE("area lights: bad input is a located error") {
   CHECK(pbrtError("AreaLightSource \"diffuse\"\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 2 0 0] \"integer indices\" [0 1 2]\n")
             .find("zero area") != std::string::npos);
   CHECK(pbrtError("AreaLightSource \"diffuse\"\nScale 1 2 1\nShape \"sphere\"\n").find("ellipsoid") != std::string::npos);
+}
+
+TEST_CASE("a mesh light's triangles are part of the scene's fingerprint (resume refuses a changed one)") {
+  auto d = test::emptyScene(8, 8);
+  d.lights.push_back(meshLight(2.0f, Rgb(10.0f)));
+  std::string a = sceneDigest(d);
+  d.lights[0].mesh.vertices[1].x = 1.5f;
+  CHECK(sceneDigest(d) != a);
+  d.lights[0].mesh.vertices[1].x = 1.0f;
+  CHECK(sceneDigest(d) == a);
+  d.lights[0].twoSided = true;
+  CHECK(sceneDigest(d) != a);
 }
