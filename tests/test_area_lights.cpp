@@ -449,3 +449,24 @@ TEST_CASE("a mesh light's triangles are part of the scene's fingerprint (resume 
   d.lights[0].twoSided = true;
   CHECK(sceneDigest(d) != a);
 }
+
+TEST_CASE("pbrt import: a mesh emitter with shading normals N faces them, as pbrt turns its triangles") {
+  // Wound to face -y, with N = +y at every vertex: pbrt emits upward
+  // (and ignores ReverseOrientation for such a mesh).
+  for (const char* extra : {"", "ReverseOrientation\n"}) {
+    for (const char* tris : {"[0 1 2]", "[0 1 2 0 2 3]"}) {  // one triangle: a mesh light; two: a rectangle
+      CAPTURE(extra);
+      CAPTURE(tris);
+      std::string text = std::string("Camera \"perspective\"\nWorldBegin\nAreaLightSource \"diffuse\"\n") + extra +
+                         "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 1 0 1 0 0 1] \"integer indices\" " + tris +
+                         " \"normal N\" [0 1 0 0 1 0 0 1 0 0 1 0]\n";
+      pbrt::ImportResult r = pbrt::importPbrtText(text, "n.pbrt");
+      auto s = Scene::build(r.scene);
+      const Light& l = s->lights[0];
+      Vec3f c = areaLightFrame(l, 0.5f).center;
+      if (l.shape == Light::AreaShape::Mesh) c = s->lights[0].mesh->centroid;
+      CHECK(irradiance(l, c + Vec3f(0, 1, 0), {0, -1, 0}, 0.5f, 16) > 0.0);
+      CHECK(irradiance(l, c - Vec3f(0, 1, 0), {0, 1, 0}, 0.5f, 16) == 0.0);
+    }
+  }
+}

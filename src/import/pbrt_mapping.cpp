@@ -829,6 +829,23 @@ void Importer::emitRoundLight(const ShapeRecord& rec, const Mat ctm[2]) {
   pushAreaLight(rec, std::move(l));
 }
 
+// pbrt turns a triangle with shading normals N to face them (and then
+// ignores ReverseOrientation): a one-sided mesh emitter's windings are
+// flipped where they disagree with the sum of their vertices' N (object
+// space; the bake keeps the agreement, normals transforming alike).
+static void orientByShadingNormals(const ShapeRecord& rec, const std::vector<Vec3f>& verts, scene::LightDesc* l) {
+  if (rec.type != "trianglemesh" || !rec.params.has("N")) return;
+  std::vector<double> N = rec.params.getFloats("N");
+  if (N.size() != 3 * verts.size()) return;  // pbrt would refuse; tdpm ignores N (noted)
+  auto n = [&](uint32_t i) { return Vec3f{float(N[3 * i]), float(N[3 * i + 1]), float(N[3 * i + 2])}; };
+  std::vector<uint32_t>& idx = l->mesh.indices;
+  for (size_t t = 0; t + 2 < idx.size(); t += 3) {
+    Vec3f g = cross(verts[idx[t + 1]] - verts[idx[t]], verts[idx[t + 2]] - verts[idx[t]]);
+    if (dot(g, n(idx[t]) + n(idx[t + 1]) + n(idx[t + 2])) < 0) std::swap(idx[t + 1], idx[t + 2]);
+  }
+  l->reverseOrientation = false;
+}
+
 // A triangle mesh with an AreaLightSource: a rectangle light when it is one
 // still rectangle of two triangles facing the same way (as before), else a
 // mesh emitter (any triangles, sampled by area).
@@ -882,6 +899,14 @@ void Importer::emitAreaLight(const ShapeRecord& rec, const std::vector<Vec3f>& v
                 dot(tri[0], tri[1]) > 0;
     if (rectangle) {
       Vec3f n = normalize(tri[0]);
+      if (rec.type == "trianglemesh" && rec.params.has("N")) {
+        // Faces its shading normals, as orientByShadingNormals below.
+        std::vector<double> N = rec.params.getFloats("N");
+        Vec3f sum{0, 0, 0};
+        for (size_t i = 0; i + 2 < N.size(); i += 3) sum += Vec3f{float(N[i]), float(N[i + 1]), float(N[i + 2])};
+        if (dot(n, M.normal(sum)) < 0) n = -n;
+        l.reverseOrientation = false;
+      }
       Vec3f x = e1 / l1, y = -n, z = cross(x, y);
       double R[3][3] = {{x.x, y.x, z.x}, {x.y, y.y, z.y}, {x.z, y.z, z.z}};
       l.areaShape = scene::LightDesc::AreaShape::Rect;
@@ -895,6 +920,7 @@ void Importer::emitAreaLight(const ShapeRecord& rec, const std::vector<Vec3f>& v
     l.areaShape = scene::LightDesc::AreaShape::Mesh;
     l.mesh.type = scene::ShapeDesc::Type::Mesh;
     l.mesh.indices = idx;
+    orientByShadingNormals(rec, verts, &l);
     if (!plan.moving) {
       // Baked like a plain mesh (emitShape): a mirroring map's winding swapped back.
       for (Vec3f v : verts) l.mesh.vertices.push_back(M.point(v));
