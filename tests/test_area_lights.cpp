@@ -470,3 +470,26 @@ TEST_CASE("pbrt import: a mesh emitter with shading normals N faces them, as pbr
     }
   }
 }
+
+TEST_CASE("moving disk and mesh lights: Embree's geometry, the frame and the pdfs agree at every time") {
+  scene::LightDesc disk = diskLight(0.5f, {0, 0, 0}, Rgb(10.0f));
+  disk.motion = test::translation({-1, 2, 0}, {1, 2, 0});
+  disk.motion.poses[1].rotate = Quaternion::fromAxisAngle({0, 0, 1}, 0.5f);  // tilts as it goes
+  scene::LightDesc mesh = meshLight(0.0f, Rgb(10.0f));
+  mesh.motion = test::translation({-1, 3, 0}, {1, 3, 0});
+  mesh.motion.poses[1].scale = {2, 2, 2};  // grows: every area x 4 by the end
+  auto sd = lightsOnly({disk}), sm = lightsOnly({mesh});
+  for (float t : {0.0f, 0.3f, 1.0f}) {
+    CAPTURE(t);
+    checkPdfConsistency(*sd, sd->lights[0], {0.2f, 0, 0.1f}, t);
+    checkPdfConsistency(*sm, sm->lights[0], {0.5f, 0, 0.5f}, t);
+    Hit h;
+    REQUIRE(sd->intersect({-1 + 2 * t, 0, 0}, {0, 1, 0}, 2.5f, t, h));  // the disk's centre is above
+    CHECK(h.isLight());
+  }
+  const Light& m = sm->lights[0];
+  CHECK(areaLightFrame(m, 0.0f).area == doctest::Approx(4.0f));
+  CHECK(areaLightFrame(m, 1.0f).area == doctest::Approx(16.0f));
+  // The watts stay the same: the radiance falls as the area grows.
+  CHECK(areaLightFrame(m, 1.0f).radiance.g == doctest::Approx(10.0f / (kPi * 16.0f)));
+}
