@@ -421,6 +421,20 @@ TEST_CASE("area lights: bad input is a located error") {
         std::string::npos);
   CHECK(jsonError(R"({"type": "disk", "size": [1, 1]})").find("lights[0]") != std::string::npos);
   CHECK(jsonError(R"({"type": "mesh"})").find("file") != std::string::npos);
+  // A mesh light of collinear triangles has no area.
+  scene::MeshSource flat = [](const std::string&, std::vector<Vec3f>* v, std::vector<uint32_t>* i) {
+    *v = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+    *i = {0, 1, 2};
+    return true;
+  };
+  std::string e;
+  try {
+    scene::parseScene(R"({"camera": {}, "materials": {}, "objects": [], "lights": [{"type": "mesh", "file": "flat.obj"}]})", "t.json", flat);
+  } catch (const Error& x) {
+    e = x.what();
+  }
+  CAPTURE(e);
+  CHECK(e.find("lights[0].file: the light's area 0 m^2") != std::string::npos);
 
   auto pbrtError = [](const std::string& world) {
     try {
