@@ -545,3 +545,20 @@ TEST_CASE("caustic photons aimed at the glass (projection maps) keep the energy 
     CHECK(with.emitted < without.emitted);
   }
 }
+
+TEST_CASE("mesh lights under a mirror emit from the object-space normal's side, still or moving") {
+  // Faces -y in object space (meshLight); mirrored in x: still -y.
+  for (bool moving : {false, true}) {
+    CAPTURE(moving);
+    scene::LightDesc l = meshLight(0.0f, Rgb(10.0f));
+    l.placement.scale = {-1, 1, 1};
+    l.placement.translate = {0, 2, 0};
+    if (moving) l.motion = test::translation({0, 0, 0}, {0.1f, 0, 0});
+    auto s = lightsOnly({l});
+    const Light& m = s->lights[0];
+    Vec3f c = areaLightFrame(m, 0.5f).center;
+    CHECK(irradiance(m, c - Vec3f(0, 1, 0), {0, 1, 0}, 0.5f, 16) > 0.0);
+    CHECK(irradiance(m, c + Vec3f(0, 1, 0), {0, -1, 0}, 0.5f, 16) == 0.0);
+    checkPdfConsistency(*s, m, c - Vec3f(0, 1, 0), 0.5f);
+  }
+}

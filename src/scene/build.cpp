@@ -111,8 +111,14 @@ void prepareEmitter(Light& l, const scene::LightDesc& d) {
   }
   const Affine3f& m0 = l.motion.step(0);
   bool moving = l.motion.moving();
-  if (!moving)
+  if (!moving) {
+    // World vertices; a mirroring placement's winding swapped back, so that
+    // the emitting side is the object-space normal transformed as a normal
+    // (as a moving light's, and as objects' normals are).
     for (Vec3f& v : mesh->vertices) v = m0.point(v);
+    if (m0.determinant3() < 0)
+      for (size_t i = 0; i + 2 < mesh->indices.size(); i += 3) std::swap(mesh->indices[i + 1], mesh->indices[i + 2]);
+  }
   mesh->det0 = std::fabs(m0.determinant3());
   double total = 0;
   Vec3f centroid{0, 0, 0};
