@@ -128,6 +128,12 @@ TEST_CASE("sphere light: irradiance on a plane against the closed form, pdfs as 
   checkPdfConsistency(*s, l, p, 0.5f);
   checkPdfConsistency(*s, l, {0, 2.49f, 0}, 0.5f);  // just outside: the cone is almost a hemisphere
 
+  // A tiny sphere far away (veach-mis's smallest light is 0.05 m at ~10 m):
+  // 1 - cos theta_max = 1.25e-7 is below float's spacing near 1.
+  auto tiny = lightsOnly({sphereLight(0.01f, {0, 20, 0}, Rgb(P))});
+  float Lt = P / (4.0f * kPi * kPi * 1e-4f);
+  CHECK(irradiance(tiny->lights[0], {0, 0, 0}, {0, 1, 0}) == doctest::Approx(kPi * Lt * 1e-4 / 400.0).epsilon(1e-3));
+
   // Inside an inward-emitting sphere every direction sees L: E = pi L.
   scene::LightDesc in = sphereLight(2.0f, {0, 0, 0}, Rgb(P));
   in.reverseOrientation = true;
