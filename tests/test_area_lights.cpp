@@ -428,6 +428,12 @@ TEST_CASE("area lights: bad input is a located error") {
         std::string::npos);
   CHECK(jsonError(R"({"type": "disk", "size": [1, 1]})").find("lights[0]") != std::string::npos);
   CHECK(jsonError(R"({"type": "mesh"})").find("file") != std::string::npos);
+  // Rotating round lights are fine (the motion's blended steps shorten axes
+  // a little: no shape change); a keyframe that stretches them is not.
+  CHECK(jsonError(R"({"type": "disk", "motion": [{"time": 0}, {"time": 1, "rotate": {"axis": [0, 0, 1], "angle": 90}}]})") == "");
+  CHECK(jsonError(R"({"type": "sphere", "motion": [{"time": 0}, {"time": 1, "rotate": {"axis": [1, 1, 0], "angle": 170}}]})") == "");
+  CHECK(jsonError(R"({"type": "sphere", "motion": [{"time": 0}, {"time": 1, "scale": [1, 1, 2]}]})")
+            .find("lights[0].motion: a sphere light must scale uniformly") != std::string::npos);
   // A mesh light of collinear triangles has no area.
   scene::MeshSource flat = [](const std::string&, std::vector<Vec3f>* v, std::vector<uint32_t>* i) {
     *v = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};

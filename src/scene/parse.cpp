@@ -682,26 +682,32 @@ void readEmitterShape(const Node& n, const std::string& typeName, const std::str
 Bounds3f checkEmitterShape(const Node& n, const LightDesc& l, const Motion& m) {
   Bounds3f local;
   const char* where = l.areaShape == LightDesc::AreaShape::Mesh ? "file" : l.areaShape == LightDesc::AreaShape::Rect ? "size" : "radius";
-  for (int i = 0; i < m.stepCount(); ++i) {
-    const Affine3f& a = m.step(i);
-    float lx = length(a.vector({1, 0, 0})), ly = length(a.vector({0, 1, 0})), lz = length(a.vector({0, 0, 1}));
-    Node at = memberOr(n, "transform");
-    if (n.has("motion")) at = n.member("motion");
+  // Shapes by the poses' scales (the motion's steps blend rotations, which
+  // shortens their axes slightly and unequally: not a change of shape).
+  std::vector<Vec3f> scales = {l.placement.scale};
+  for (const TransformDesc& k : l.motion.poses) scales.push_back(k.scale * l.placement.scale);
+  Node at = n.has("motion") ? n.member("motion") : memberOr(n, "transform");
+  for (size_t i = 0; i < scales.size(); ++i) {
+    if (i == 0 && !l.motion.empty()) continue;  // the keys' products are what moves
+    Vec3f sc{std::fabs(scales[i].x), std::fabs(scales[i].y), std::fabs(scales[i].z)};
     if (l.areaShape == LightDesc::AreaShape::Sphere)
-      at.require(std::fabs(lx - ly) <= 1e-5f * lx && std::fabs(lx - lz) <= 1e-5f * lx,
-                 "a sphere light must scale uniformly (an ellipsoid is not supported), got axis scales " +
-                     formatVec({lx, ly, lz}));
+      at.require(std::fabs(sc.x - sc.y) <= 1e-5f * sc.x && std::fabs(sc.x - sc.z) <= 1e-5f * sc.x,
+                 "a sphere light must scale uniformly (an ellipsoid is not supported), got scale " + formatVec(scales[i]));
     if (l.areaShape == LightDesc::AreaShape::Disk)
-      at.require(std::fabs(lx - lz) <= 1e-5f * lx && std::fabs(dot(a.vector({1, 0, 0}), a.vector({0, 0, 1}))) <= 1e-5f * lx * lz,
+      at.require(std::fabs(sc.x - sc.z) <= 1e-5f * sc.x,
                  "a disk light must scale alike along its local x and z (an ellipse is not supported), got " +
-                     fmt(lx) + " and " + fmt(lz));
-    if (l.areaShape == LightDesc::AreaShape::Mesh && i > 0) {
-      // Relative triangle areas must stay those of step 0.
-      float r0 = length(m.step(0).vector({1, 0, 0})), r1 = length(m.step(0).vector({0, 1, 0})), r2 = length(m.step(0).vector({0, 0, 1}));
-      float kx = lx / r0, ky = ly / r1, kz = lz / r2;
-      at.require(std::fabs(kx - ky) <= 1e-4f * kx && std::fabs(kx - kz) <= 1e-4f * kx,
+                     fmt(sc.x) + " and " + fmt(sc.z));
+    if (l.areaShape == LightDesc::AreaShape::Mesh && i > 1) {
+      // Relative triangle areas must stay those of the first key.
+      Vec3f s0 = l.motion.poses[0].scale, si = l.motion.poses[i - 1].scale;
+      Vec3f k{si.x / s0.x, si.y / s0.y, si.z / s0.z};
+      at.require(std::fabs(k.x - k.y) <= 1e-5f * std::fabs(k.x) && std::fabs(k.x - k.z) <= 1e-5f * std::fabs(k.x),
                  "a moving mesh light may change its size only uniformly (its triangles' relative areas must stay fixed)");
     }
+  }
+  for (int i = 0; i < m.stepCount(); ++i) {
+    const Affine3f& a = m.step(i);
+    float lx = length(a.vector({1, 0, 0})), lz = length(a.vector({0, 0, 1}));
     float area = 0;
     switch (l.areaShape) {
       case LightDesc::AreaShape::Rect:
