@@ -465,6 +465,38 @@ TEST_CASE("area lights: bad input is a located error") {
   CHECK(pbrtError("AreaLightSource \"diffuse\"\nScale 1 2 1\nShape \"sphere\"\n").find("ellipsoid") != std::string::npos);
 }
 
+TEST_CASE("pbrt import: a twosided mesh emitter's watts are 2 L pi A; a moving one keeps pbrt's side") {
+  // A trapezoid (not a rectangle: a mesh light) of area 1.5 at y = 1,
+  // and a triangle facing +y moving along x.
+  std::string text = R"(Camera "perspective" "float shutteropen" 0 "float shutterclose" 1
+WorldBegin
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [2 2 2] "bool twosided" true
+  Shape "trianglemesh" "point3 P" [0 1 0  2 1 0  1.5 1 1  0.5 1 1] "integer indices" [0 1 2 0 2 3]
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [1 1 1]
+  ActiveTransform EndTime
+  Translate 1 0 0
+  ActiveTransform All
+  Shape "trianglemesh" "point3 P" [0 3 0  1 3 0  0 3 1] "integer indices" [0 2 1]
+AttributeEnd
+)";
+  pbrt::ImportResult r = pbrt::importPbrtText(text, "two.pbrt");
+  REQUIRE(r.scene.lights.size() == 2);
+  CHECK(r.scene.lights[0].areaShape == scene::LightDesc::AreaShape::Mesh);
+  CHECK(r.scene.lights[0].power.g == doctest::Approx(2 * 2 * kPi * 1.5f));
+  CHECK(!r.scene.lights[1].motion.empty());
+  auto s = Scene::build(r.scene);
+  // pbrt's normal (0,0,1) x (1,0,0) = +y, under the import's x mirror too.
+  const Light& m = s->lights[1];
+  for (float t : {0.0f, 1.0f}) {
+    Vec3f c = areaLightFrame(m, t).center;
+    CHECK(irradiance(m, c + Vec3f(0, 1, 0), {0, -1, 0}, t, 16) > 0.0);
+    CHECK(irradiance(m, c - Vec3f(0, 1, 0), {0, 1, 0}, t, 16) == 0.0);
+  }
+}
+
 TEST_CASE("a mesh light's triangles are part of the scene's fingerprint (resume refuses a changed one)") {
   auto d = test::emptyScene(8, 8);
   d.lights.push_back(meshLight(2.0f, Rgb(10.0f)));
