@@ -116,7 +116,7 @@ TEST_CASE("glass: the photon methods split the first glass vertex, so a reflecte
         Vec3f r = dir + n * (2.0f * cosI);
         Hit hl;
         if (!s->intersect(s->spawnOrigin(h.p, n, r), r, 1e30f, 0.5f, hl) || !hl.isLight()) { all = false; break; }
-        if (off.x == 0.5f) analytic = fresnelDielectric(cosI, 1.5f) * areaLightRadiance(lamp, lf, -r).average();
+        if (off.x == 0.5f) analytic = fresnelDielectric(cosI, 1.5f) * areaLightRadiance(lamp, lf, hl.n, -r).average();
       }
       if (all) highlight.push_back({size_t(y) * 48 + size_t(x), analytic});
     }

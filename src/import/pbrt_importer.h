@@ -126,6 +126,11 @@ class Importer {
 
   // mapping
   void emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& instanceAt);
+  // Sphere and disk emitters (pbrt_mapping.cpp); the radiance and power
+  // shared by every emitter; the light pushed with its material note.
+  void emitRoundLight(const ShapeRecord& rec, const Mat ctm[2]);
+  Rgb areaLightL(const ShapeRecord& rec, double area, bool twoSided);
+  void pushAreaLight(const ShapeRecord& rec, scene::LightDesc l);
   void emitAreaLight(const ShapeRecord& rec, const std::vector<Vec3f>& verts, const std::vector<uint32_t>& idx,
                      const Mat ctm[2]);
   struct MotionPlan {

@@ -820,13 +820,15 @@ static CheckerFrame placeChecker(const std::vector<Vec3f>& world, const std::vec
 }
 
 void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& instanceAt) {
+  if (rec.area && rec.type == "disk") return emitRoundLight(rec, ctm);  // an emitter only: no Geometry
   Geometry g = makeGeometry(rec, [&](const std::string& w) { note(rec.at, w); }, mainDir, result.inputFiles);
   countTriangles(g.indices.size() / 3, instanceAt.file.empty() ? rec.at : instanceAt,
                  instanceAt.file.empty() ? "Shape \"" + rec.type + "\"" : "ObjectInstance (Shape \"" + rec.type + "\" at " + rec.at.str() + ")");
   const MaterialSlot& mat = materials_[size_t(rec.material)];
   if (rec.area) {
-    if (g.sphere || g.quadric)
-      failAt(rec.at, "Shape \"" + rec.type + "\" with an AreaLightSource: tdpm's area lights are rectangles");
+    if (g.quadric)
+      failAt(rec.at, "Shape \"" + rec.type + "\" with an AreaLightSource is not supported (emitters: sphere, disk, triangle meshes)");
+    if (g.sphere) return emitRoundLight(rec, ctm);
     if (g.loopLevels >= 0) {
       scene::LoopMesh m = scene::loopSubdivide(g.vertices, g.indices, g.loopLevels, scene::limits::kMaxSubdividedTriangles);
       emitAreaLight(rec, m.vertices, m.indices, ctm);
@@ -926,65 +928,200 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
   objectAt_.push_back(rec.at);
 }
 
+// pbrt's DiffuseAreaLight radiance: L x scale, or pbrt-v4's "power" (W)
+// spread over the area and sides: L = power / (pi A sides).
+Rgb Importer::areaLightL(const ShapeRecord& rec, double area, bool twoSided) {
+  const ParamSet& ps = rec.area->params;
+  Rgb L = nonNegative(ps, "L", color(ps, "L", Rgb(1.0f))) * lightScale(ps);
+  double power = ps.has("power") ? ps.getFloat("power", -1) : -1;
+  if (power > 0) L = L * float(power / (kPiD * area * (twoSided ? 2 : 1)));
+  if (ps.has("filename")) failAt(rec.area->at, "AreaLightSource: an image emitter (filename) is not supported");
+  noteLightSamples(ps, rec.area->at, "AreaLightSource");
+  ps.checkAllUsed();
+  return L;
+}
+
+void Importer::pushAreaLight(const ShapeRecord& rec, scene::LightDesc l) {
+  const MaterialSlot& mat = materials_[size_t(rec.material)];
+  bool black = mat.interface || (mat.desc.type == scene::MaterialDesc::Type::Diffuse && mat.desc.albedo.color.isBlack());
+  if (!black) note(rec.at, l.name + ": tdpm's area lights do not reflect light; the emitter's material is ignored");
+  result.scene.lights.push_back(std::move(l));
+  lightAt_.push_back(rec.area->at);
+}
+
+// A sphere or a disk with an AreaLightSource. pbrt's disk lies in its z =
+// height plane facing +z; tdpm's in its local x-z plane emitting toward -y,
+// so a rotation by -90 degrees about x (taking -y to +z) goes in between.
+// pbrt flips either's normal when ReverseOrientation and a handedness-
+// swapping transform disagree.
+void Importer::emitRoundLight(const ShapeRecord& rec, const Mat ctm[2]) {
+  const ParamSet& ps = rec.params;
+  bool disk = rec.type == "disk";
+  const std::string what = "AreaLightSource (" + rec.area->at.str() + ") on Shape \"" + rec.type + "\"";
+  double r = ps.getFloat("radius", 1);
+  if (!(r > 0)) failAt(rec.at, "Shape \"" + rec.type + "\": radius must be positive, got " + fmtNum(r));
+  Mat local;
+  if (disk) {
+    double inner = ps.getFloat("innerradius", 0), phimax = ps.getFloat("phimax", 360), h = ps.getFloat("height", 0);
+    if (inner != 0 || phimax < 360) failAt(rec.at, "Shape \"disk\": an annulus or a partial disk (innerradius, phimax) is not supported as an emitter");
+    local = Mat::translate(0, 0, h) * Mat::rotate(-90, 1, 0, 0);
+  } else {
+    double zmin = ps.getFloat("zmin", -r), zmax = ps.getFloat("zmax", r), phimax = ps.getFloat("phimax", 360);
+    if (zmin > -r || zmax < r || phimax < 360)
+      failAt(rec.at, "Shape \"sphere\": partial spheres (zmin, zmax, phimax) are not supported");
+  }
+  ps.checkAllUsed();
+  bool twoSided = rec.area->params.getBool("twosided", false);
+  Mat placed[2] = {ctm[0] * local, ctm[1] * local};
+  MotionPlan plan = planMotion(placed, rec.at, what);
+  scene::LightDesc l;
+  l.type = scene::LightDesc::Type::Area;
+  l.areaShape = disk ? scene::LightDesc::AreaShape::Disk : scene::LightDesc::AreaShape::Sphere;
+  l.name = what;
+  l.radius = float(r);
+  l.twoSided = twoSided;
+  l.reverseOrientation = rec.reverseOrientation != (ctm[0].det3() < 0);
+  auto round = [&](Vec3f s) {
+    float a = std::fabs(s.x);
+    return disk ? std::fabs(std::fabs(s.z) - a) <= 1e-5f * a : nearlyUniform(s);
+  };
+  const char* shapeWord = disk ? "an ellipse" : "an ellipsoid";
+  Vec3f scale0;
+  if (!plan.moving) {
+    std::string degenerate = scaleProblem(plan.still);
+    if (!degenerate.empty()) failAt(rec.at, what + ": its transform is unusable: " + degenerate);
+    std::optional<Pose> p = decompose(plan.still);
+    if (!p || !round(p->scale)) failAt(rec.at, what + " under a non-uniform scale or shear (" + shapeWord + ") is not supported");
+    l.placement.translate = p->translate;
+    l.placement.rotate = canonicalRotation(p->rotate);
+    l.placement.scale = p->scale;
+    scale0 = p->scale;
+  } else {
+    for (const auto& k : plan.keys.poses)
+      if (!round(k.scale)) failAt(rec.at, what + " under a non-uniform scale (" + shapeWord + ") is not supported");
+    l.motion = plan.keys;
+    scale0 = plan.keys.poses[0].scale;
+  }
+  float s = std::fabs(scale0.x);
+  double area = disk ? kPiD * r * r * s * s : 4.0 * kPiD * r * r * s * s;  // at the first pose (pbrt's Area())
+  Rgb L = areaLightL(rec, area, twoSided);
+  l.power = L * float(kPiD * area * (twoSided ? 2 : 1));  // Lambertian: power = L pi A sides
+  pushAreaLight(rec, std::move(l));
+}
+
+// pbrt turns a triangle with shading normals N to face them (and then
+// ignores ReverseOrientation): a one-sided mesh emitter's windings are
+// flipped where they disagree with the sum of their vertices' N (object
+// space; the bake keeps the agreement, normals transforming alike).
+static void orientByShadingNormals(const ShapeRecord& rec, const std::vector<Vec3f>& verts, scene::LightDesc* l) {
+  if (rec.type != "trianglemesh" || !rec.params.has("N")) return;
+  std::vector<double> N = rec.params.getFloats("N");
+  if (N.size() != 3 * verts.size()) return;  // pbrt would refuse; tdpm ignores N (noted)
+  auto n = [&](uint32_t i) { return Vec3f{float(N[3 * i]), float(N[3 * i + 1]), float(N[3 * i + 2])}; };
+  std::vector<uint32_t>& idx = l->mesh.indices;
+  for (size_t t = 0; t + 2 < idx.size(); t += 3) {
+    Vec3f g = cross(verts[idx[t + 1]] - verts[idx[t]], verts[idx[t + 2]] - verts[idx[t]]);
+    if (dot(g, n(idx[t]) + n(idx[t + 1]) + n(idx[t + 2])) < 0) std::swap(idx[t + 1], idx[t + 2]);
+  }
+  l->reverseOrientation = false;
+}
+
+// A triangle mesh with an AreaLightSource: a rectangle light when it is one
+// still rectangle of two triangles facing the same way (as before), else a
+// mesh emitter (any triangles, sampled by area).
 void Importer::emitAreaLight(const ShapeRecord& rec, const std::vector<Vec3f>& verts, const std::vector<uint32_t>& idx,
                              const Mat ctm[2]) {
   const ParamSet& ps = rec.area->params;
   const std::string what = "AreaLightSource (" + rec.area->at.str() + ") on Shape \"" + rec.type + "\"";
   bool twoSided = ps.getBool("twosided", false);
-  if (twoSided) failAt(rec.area->at, "AreaLightSource: twosided emitters are not supported (tdpm's area lights emit from one side)");
   MotionPlan plan = planMotion(ctm, rec.at, what);
-  if (plan.moving) failAt(rec.at, what + ": a moving area light is not supported");
-  const Mat& M = plan.still;
-  // tdpm's area light is one rectangle: the shape must be two triangles
-  // covering a rectangle, both facing the same way.
-  std::vector<uint32_t> corners(idx.begin(), idx.end());
-  std::sort(corners.begin(), corners.end());
-  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
-  if (idx.size() != 6 || corners.size() != 4)
-    failAt(rec.at, what + ": tdpm's area lights are rectangles; the shape must be one rectangle (2 triangles, 4 points)");
-  Vec3f P[4];
-  for (int i = 0; i < 4; ++i) P[i] = M.point(verts[corners[size_t(i)]]);
-  int far = 1;
-  for (int i = 2; i < 4; ++i)
-    if (length(P[i] - P[0]) > length(P[far] - P[0])) far = i;
-  int a = far == 1 ? 2 : 1, b = far == 3 ? 2 : 3;
-  Vec3f e1 = P[a] - P[0], e2 = P[b] - P[0];
-  float l1 = length(e1), l2 = length(e2);
-  Vec3f tri[2];
-  float triArea = 0;
-  for (int t = 0; t < 2; ++t) {
-    Vec3f p0 = verts[idx[size_t(3 * t)]], p1 = verts[idx[size_t(3 * t + 1)]], p2 = verts[idx[size_t(3 * t + 2)]];
-    tri[t] = M.normal(cross(p1 - p0, p2 - p0));  // pbrt's normal: the object-space one, transformed as a normal
-    triArea += 0.5f * length(cross(M.point(p1) - M.point(p0), M.point(p2) - M.point(p0)));
-  }
-  float rectArea = l1 * l2;
-  bool rectangle = l1 > 0 && l2 > 0 && std::fabs(dot(e1, e2)) <= 1e-4f * l1 * l2 &&
-                   length(P[0] + e1 + e2 - P[far]) <= 1e-4f * (l1 + l2) && std::fabs(triArea - rectArea) <= 1e-4f * rectArea &&
-                   dot(tri[0], tri[1]) > 0;
-  if (!rectangle) failAt(rec.at, what + ": the shape is not a rectangle of two triangles facing the same way");
-  Vec3f n = normalize(tri[0]);
-  if (rec.reverseOrientation) n = -n;  // pbrt: the emitting side follows the flipped normal
-  Vec3f x = e1 / l1, y = -n, z = cross(x, y);
-  double R[3][3] = {{x.x, y.x, z.x}, {x.y, y.y, z.y}, {x.z, y.z, z.z}};
-  Rgb L = nonNegative(ps, "L", color(ps, "L", Rgb(1.0f))) * lightScale(ps);
-  double power = ps.has("power") ? ps.getFloat("power", -1) : -1;
-  if (power > 0) L = L * float(power / (kPiD * rectArea));  // pbrt-v4: one side, area A
-  if (ps.has("filename")) failAt(rec.area->at, "AreaLightSource: an image emitter (filename) is not supported");
-  noteLightSamples(ps, rec.area->at, "AreaLightSource");
-  ps.checkAllUsed();
   scene::LightDesc l;
   l.type = scene::LightDesc::Type::Area;
   l.name = what;
-  l.areaSize = {l1, l2};
-  l.placement.translate = P[0] + (e1 + e2) * 0.5f;
-  l.placement.rotate = canonicalRotation(quaternionFromMatrix(R));
-  l.power = L * float(kPiD * rectArea);  // Lambertian: power = L pi A
-  const MaterialSlot& mat = materials_[size_t(rec.material)];
-  bool black = mat.interface || (mat.desc.type == scene::MaterialDesc::Type::Diffuse && mat.desc.albedo.color.isBlack());
-  if (!black)
-    note(rec.at, what + ": tdpm's area lights do not reflect light; the emitter's material is ignored");
-  result.scene.lights.push_back(l);
-  lightAt_.push_back(rec.area->at);
+  l.twoSided = twoSided;
+  l.reverseOrientation = rec.reverseOrientation;  // the winding already follows pbrt's handedness rule
+  const Mat& M = plan.still;
+  // World (first pose) area, for "power" and the light's watts.
+  Mat M0 = plan.moving ? Mat() : M;
+  double area = 0;
+  for (size_t t = 0; t + 2 < idx.size(); t += 3) {
+    Vec3f p0 = verts[idx[t]], p1 = verts[idx[t + 1]], p2 = verts[idx[t + 2]];
+    if (plan.moving) {
+      Affine3f a = plan.keys.poses[0].matrix();
+      p0 = a.point(p0); p1 = a.point(p1); p2 = a.point(p2);
+    } else {
+      p0 = M0.point(p0); p1 = M0.point(p1); p2 = M0.point(p2);
+    }
+    area += 0.5 * double(length(cross(p1 - p0, p2 - p0)));
+  }
+  if (!(area > 1e-30)) failAt(rec.at, what + ": the emitter has zero area");
+  std::vector<uint32_t> corners(idx.begin(), idx.end());
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  bool rectangle = false;
+  if (!plan.moving && idx.size() == 6 && corners.size() == 4) {
+    Vec3f P[4];
+    for (int i = 0; i < 4; ++i) P[i] = M.point(verts[corners[size_t(i)]]);
+    int far = 1;
+    for (int i = 2; i < 4; ++i)
+      if (length(P[i] - P[0]) > length(P[far] - P[0])) far = i;
+    int a = far == 1 ? 2 : 1, b = far == 3 ? 2 : 3;
+    Vec3f e1 = P[a] - P[0], e2 = P[b] - P[0];
+    float l1 = length(e1), l2 = length(e2);
+    Vec3f tri[2];
+    for (int t = 0; t < 2; ++t) {
+      Vec3f p0 = verts[idx[size_t(3 * t)]], p1 = verts[idx[size_t(3 * t + 1)]], p2 = verts[idx[size_t(3 * t + 2)]];
+      tri[t] = M.normal(cross(p1 - p0, p2 - p0));  // pbrt's normal: the object-space one, transformed as a normal
+    }
+    float rectArea = l1 * l2;
+    rectangle = l1 > 0 && l2 > 0 && std::fabs(dot(e1, e2)) <= 1e-4f * l1 * l2 &&
+                length(P[0] + e1 + e2 - P[far]) <= 1e-4f * (l1 + l2) && std::fabs(float(area) - rectArea) <= 1e-4f * rectArea &&
+                dot(tri[0], tri[1]) > 0;
+    if (rectangle) {
+      Vec3f n = normalize(tri[0]);
+      if (rec.type == "trianglemesh" && rec.params.has("N")) {
+        // Faces its shading normals, as orientByShadingNormals below.
+        std::vector<double> N = rec.params.getFloats("N");
+        Vec3f sum{0, 0, 0};
+        for (size_t i = 0; i + 2 < N.size(); i += 3) sum += Vec3f{float(N[i]), float(N[i + 1]), float(N[i + 2])};
+        if (dot(n, M.normal(sum)) < 0) n = -n;
+        l.reverseOrientation = false;
+      }
+      Vec3f x = e1 / l1, y = -n, z = cross(x, y);
+      double R[3][3] = {{x.x, y.x, z.x}, {x.y, y.y, z.y}, {x.z, y.z, z.z}};
+      l.areaShape = scene::LightDesc::AreaShape::Rect;
+      l.areaSize = {l1, l2};
+      l.placement.translate = P[0] + (e1 + e2) * 0.5f;
+      l.placement.rotate = canonicalRotation(quaternionFromMatrix(R));
+      area = rectArea;
+    }
+  }
+  if (!rectangle) {
+    l.areaShape = scene::LightDesc::AreaShape::Mesh;
+    l.mesh.type = scene::ShapeDesc::Type::Mesh;
+    l.mesh.indices = idx;
+    orientByShadingNormals(rec, verts, &l);
+    if (!plan.moving) {
+      // Baked like a plain mesh (emitShape): a mirroring map's winding swapped back.
+      for (Vec3f v : verts) l.mesh.vertices.push_back(M.point(v));
+      if (M.det3() < 0)
+        for (size_t i = 0; i < l.mesh.indices.size(); i += 3) std::swap(l.mesh.indices[i + 1], l.mesh.indices[i + 2]);
+    } else {
+      l.mesh.vertices = verts;
+      l.motion = plan.keys;
+      for (const auto& k : plan.keys.poses) {
+        Vec3f s0 = plan.keys.poses[0].scale;
+        Vec3f q{k.scale.x / s0.x, k.scale.y / s0.y, k.scale.z / s0.z};
+        if (!nearlyUniform(q)) failAt(rec.at, what + ": a moving emissive mesh may change its size only uniformly");
+      }
+    }
+    for (Vec3f v : l.mesh.vertices)
+      if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+        failAt(rec.at, what + ": a vertex is not finite after its transform");
+  }
+  Rgb L = areaLightL(rec, area, twoSided);
+  l.power = L * float(kPiD * area * (twoSided ? 2 : 1));  // Lambertian: power = L pi A sides
+  pushAreaLight(rec, std::move(l));
 }
 
 }  // namespace tdpm::pbrt::detail

@@ -54,18 +54,25 @@ void Importer::validateAsJson() {
   if (!finite(sc.background)) failAt(backgroundAt_.file.empty() ? worldAt_ : backgroundAt_,
                                      "LightSource \"infinite\": the background radiance is not a finite float");
 
-  // sceneToJson names mesh k "<stem>.mesh<k>.obj", in object order.
+  // sceneToJson names mesh k "<stem>.mesh<k>.obj", objects' in order, then
+  // mesh lights'. meshShape(d, k): mesh k of description d.
   const std::string stem = "imported";
-  std::vector<size_t> meshObject;
+  std::vector<std::pair<bool, size_t>> meshObject;  // (a light's, index)
   for (size_t i = 0; i < sc.objects.size(); ++i)
-    if (sc.objects[i].shape.type == scene::ShapeDesc::Type::Mesh) meshObject.push_back(i);
+    if (sc.objects[i].shape.type == scene::ShapeDesc::Type::Mesh) meshObject.push_back({false, i});
+  for (size_t i = 0; i < sc.lights.size(); ++i)
+    if (sc.lights[i].type == scene::LightDesc::Type::Area && sc.lights[i].areaShape == scene::LightDesc::AreaShape::Mesh)
+      meshObject.push_back({true, i});
+  auto meshShape = [&](scene::SceneDescription& d, size_t k) -> scene::ShapeDesc& {
+    return meshObject[k].first ? d.lights[meshObject[k].second].mesh : d.objects[meshObject[k].second].shape;
+  };
   SceneJson js = sceneToJson(sc, stem + ".json", /*meshText=*/false);
   const std::string meshPrefix = stem + ".mesh";
   scene::MeshSource meshes = [&](const std::string& file, std::vector<Vec3f>* v, std::vector<uint32_t>* idx) {
     if (file.compare(0, meshPrefix.size(), meshPrefix) != 0) return false;
     size_t k = std::strtoul(file.c_str() + meshPrefix.size(), nullptr, 10);
     if (k >= meshObject.size()) return false;
-    scene::ShapeDesc& s = sc.objects[meshObject[k]].shape;
+    scene::ShapeDesc& s = meshShape(sc, k);
     v->swap(s.vertices);  // lent, not copied: given back below
     idx->swap(s.indices);
     return true;
@@ -91,8 +98,8 @@ void Importer::validateAsJson() {
     failAt(at, "tdpm's scene checks refuse what " + label + " maps to (the JSON of tdpm convert would not load): " + rest);
   }
   for (size_t k = 0; k < meshObject.size(); ++k) {
-    scene::ShapeDesc& mine = sc.objects[meshObject[k]].shape;
-    scene::ShapeDesc& lent = parsed.objects[meshObject[k]].shape;
+    scene::ShapeDesc& mine = meshShape(sc, k);
+    scene::ShapeDesc& lent = meshShape(parsed, k);
     mine.vertices.swap(lent.vertices);
     mine.indices.swap(lent.indices);
   }

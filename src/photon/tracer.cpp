@@ -255,12 +255,14 @@ bool emitTowardTargets(const Light& light, const std::vector<Target>& targets, f
       // x and y crossed: the old expression drew its two rng.uniform()
       // calls right to left (GCC's order), and random keeps its maps.
       Vec2f uPos = rng.get2D(dims::kPhotonPosition);
-      Vec3f q = fr.center + fr.edgeX * (uPos.y - 0.5f) + fr.edgeZ * (uPos.x - 0.5f);
+      Vec3f q, n;
+      if (!sampleAreaLightPoint(light, fr, {uPos.y, uPos.x}, q, n)) return false;
       float pdf = sampleTowardTargets(targets, q, EmitterCone{}, uvw, out.direction);
-      float cosT = dot(out.direction, fr.normal);
+      float cosT = dot(out.direction, n);
+      if (light.twoSided) cosT = std::fabs(cosT);
       if (!(pdf > 0) || cosT <= 0) return false;
       out.origin = q;
-      out.flux = areaLightRadiance(light, fr, out.direction) * (cosT * fr.area / pdf);
+      out.flux = areaLightRadiance(light, fr, n, out.direction) * (cosT * fr.area / pdf);
       return true;
     }
     case Light::Type::Directional: {
@@ -303,11 +305,13 @@ double powerTowardTargets(const Light& light, const std::vector<Target>& targets
       for (const Target& t : targets) {
         Vec3f to = t.centre - fr.center;
         float dist = length(to);
-        float cosL = dist > 0 ? dot(to / dist, fr.normal) : 1.0f;
+        // A curved or twosided emitter faces every target somewhere: no cosine.
+        bool planar = (light.shape == Light::AreaShape::Rect || light.shape == Light::AreaShape::Disk) && !light.twoSided;
+        float cosL = dist > 0 && planar ? dot(to / dist, fr.normal) : 1.0f;
         float cone = 2.0f * kPi * (1.0f - coneCos(t, fr.center));
         sum += double(cone) * std::max(0.0f, std::min(1.0f, cosL + t.radius / std::max(dist, 1e-6f)));
       }
-      return (light.power / (kPi * fr.area)).average() * fr.area * std::min(sum, double(kPi));
+      return fr.radiance.average() * fr.area * (light.twoSided ? 2.0 : 1.0) * std::min(sum, double(kPi));
     }
     case Light::Type::Directional:
     case Light::Type::Environment:  // power: the integral of its radiance (see emittedPower)

@@ -129,6 +129,19 @@ std::string sceneDigest(const scene::SceneDescription& d) {
     s.meshFile.clear();
   }
   for (scene::LightDesc& l : c.lights) {
+    if (l.areaShape == scene::LightDesc::AreaShape::Mesh) {
+      // A mesh light's triangles, as a mesh object's.
+      scene::ShapeDesc& s = l.mesh;
+      h.add("mesh light " + l.name);
+      uint64_t nv = s.vertices.size(), ni = s.indices.size();
+      h.add(&nv, sizeof nv);
+      h.add(s.vertices.data(), s.vertices.size() * sizeof(Vec3f));
+      h.add(&ni, sizeof ni);
+      h.add(s.indices.data(), s.indices.size() * sizeof(uint32_t));
+      s.vertices.clear();
+      s.indices.clear();
+      s.meshFile.clear();
+    }
     if (!l.map) continue;
     // An environment map by its (lat-long) texels, like a mesh by its triangles.
     h.add("environment " + l.name);

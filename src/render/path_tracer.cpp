@@ -63,9 +63,9 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
     if (hit.isLight()) {
       const Light& light = scene_.lights[size_t(hit.light)];
       AreaLightFrame f = areaLightFrame(light, time01);
-      Rgb le = areaLightRadiance(light, f, -dir);
+      Rgb le = areaLightRadiance(light, f, hit.n, -dir);
       if (!le.isBlack()) {
-        float w = lastDelta ? 1.0f : emissionWeight(lastPdf, areaLightPdf(light, f, lastP, hit.p), 1);
+        float w = lastDelta ? 1.0f : emissionWeight(lastPdf, areaLightPdf(light, f, lastP, hit.p, hit.n), 1);
         L += beta * le * w;
       }
       break;  // emitters do not reflect

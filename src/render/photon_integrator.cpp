@@ -128,8 +128,8 @@ Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, flo
         if (bounce == 0) {
           const Light& light = scene_.lights[size_t(h.light)];
           AreaLightFrame f = areaLightFrame(light, time01);
-          float w = emissionWeight(bs.pdf, areaLightPdf(light, f, hit.p, h.p), s_.gatherRays);
-          sum += beta * areaLightRadiance(light, f, -d) * w;
+          float w = emissionWeight(bs.pdf, areaLightPdf(light, f, hit.p, h.p, h.n), s_.gatherRays);
+          sum += beta * areaLightRadiance(light, f, h.n, -d) * w;
         }
         break;
       }
@@ -237,8 +237,8 @@ Rgb PhotonIntegrator::traceFrom(Vec3f origin, Vec3f dir, float time01, EyeVertex
       if (emissionCounts) {
         const Light& light = scene_.lights[size_t(hit.light)];
         AreaLightFrame f = areaLightFrame(light, time01);
-        float w = metalPdf > 0.0f ? emissionWeight(metalPdf, areaLightPdf(light, f, metalP, hit.p), 1) : 1.0f;
-        addEye(beta * areaLightRadiance(light, f, -dir) * w);
+        float w = metalPdf > 0.0f ? emissionWeight(metalPdf, areaLightPdf(light, f, metalP, hit.p, hit.n), 1) : 1.0f;
+        addEye(beta * areaLightRadiance(light, f, hit.n, -dir) * w);
       }
       break;
     }

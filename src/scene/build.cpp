@@ -148,6 +148,57 @@ void classifyMix(std::vector<Material>& ms, const std::vector<scene::MaterialDes
   state[i] = 2;
 }
 
+// Per-step radii and normals (sphere, disk: Embree blends them between
+// steps, and so does the light's frame) and a mesh emitter's triangles and
+// CDF by area (world space when still, object space when moving).
+void prepareEmitter(Light& l, const scene::LightDesc& d) {
+  for (int i = 0; i < l.motion.stepCount(); ++i) {
+    const Affine3f& m = l.motion.step(i);
+    // A disk's radius is its local x axis's (parse.cpp keeps x and z alike).
+    l.stepRadius.push_back(l.shape == Light::AreaShape::Disk ? length(m.vector({l.radius, 0, 0}))
+                                                             : l.radius * uniformScale(m));
+    l.stepNormal.push_back(normalize(m.normal({0, -1, 0})));
+  }
+  if (l.shape != Light::AreaShape::Mesh) return;
+  auto mesh = std::make_shared<EmitterMesh>();
+  if (d.mesh.loopLevels >= 0) {
+    scene::LoopMesh refined = scene::loopSubdivide(d.mesh.vertices, d.mesh.indices, d.mesh.loopLevels,
+                                                   scene::limits::kMaxSubdividedTriangles);
+    mesh->vertices = std::move(refined.vertices);
+    mesh->indices = std::move(refined.indices);
+  } else {
+    mesh->vertices = d.mesh.vertices;
+    mesh->indices = d.mesh.indices;
+  }
+  const Affine3f& m0 = l.motion.step(0);
+  bool moving = l.motion.moving();
+  if (!moving) {
+    // World vertices; a mirroring placement's winding swapped back, so that
+    // the emitting side is the object-space normal transformed as a normal
+    // (as a moving light's, and as objects' normals are).
+    for (Vec3f& v : mesh->vertices) v = m0.point(v);
+    if (m0.determinant3() < 0)
+      for (size_t i = 0; i + 2 < mesh->indices.size(); i += 3) std::swap(mesh->indices[i + 1], mesh->indices[i + 2]);
+  }
+  mesh->det0 = std::fabs(m0.determinant3());
+  double total = 0;
+  Vec3f centroid{0, 0, 0};
+  std::vector<double> acc;
+  for (size_t i = 0; i < mesh->indices.size(); i += 3) {
+    Vec3f a = mesh->vertices[mesh->indices[i]], b = mesh->vertices[mesh->indices[i + 1]],
+          c = mesh->vertices[mesh->indices[i + 2]];
+    float area = moving ? 0.5f * length(cross(m0.vector(b - a), m0.vector(c - a))) : 0.5f * length(cross(b - a, c - a));
+    total += area;
+    centroid += (a + b + c) * (area / 3.0f);
+    acc.push_back(total);
+  }
+  mesh->area0 = float(total);
+  mesh->centroid = total > 0 ? centroid / float(total) : Vec3f(0, 0, 0);
+  for (double a : acc) mesh->cdf.push_back(total > 0 ? float(a / total) : 1.0f);
+  if (!mesh->cdf.empty()) mesh->cdf.back() = 1.0f;
+  l.mesh = std::move(mesh);
+}
+
 Light toLight(const scene::LightDesc& d, const Shutter& shutter) {
   Light l;
   switch (d.type) {
@@ -163,6 +214,15 @@ Light toLight(const scene::LightDesc& d, const Shutter& shutter) {
   l.cosTotal = std::cos(d.coneAngle * kPi / 180.0f);
   l.cosFalloffStart = std::cos(d.falloffStart * kPi / 180.0f);
   l.size = d.areaSize;
+  l.radius = d.radius;
+  l.twoSided = d.twoSided;
+  l.reversed = d.reverseOrientation;
+  switch (d.areaShape) {
+    case scene::LightDesc::AreaShape::Rect: l.shape = Light::AreaShape::Rect; break;
+    case scene::LightDesc::AreaShape::Sphere: l.shape = Light::AreaShape::Sphere; break;
+    case scene::LightDesc::AreaShape::Disk: l.shape = Light::AreaShape::Disk; break;
+    case scene::LightDesc::AreaShape::Mesh: l.shape = Light::AreaShape::Mesh; break;
+  }
   l.motion = makeMotion(d.placement, d.motion, shutter);
   if (l.type == Light::Type::Environment) {
     Affine3f toWorld = d.placement.matrix();
@@ -170,8 +230,48 @@ Light toLight(const scene::LightDesc& d, const Shutter& shutter) {
     l.env = std::make_shared<const EnvironmentMap>(d.map ? EnvironmentMap::fromLatLong(*d.map, k, toWorld)
                                                          : EnvironmentMap::constant(k, toWorld));
   }
+  if (l.type == Light::Type::Area) prepareEmitter(l, d);
   finalizeLight(l);
   return l;
+}
+
+// An area light's emitter into Embree (camera and BSDF rays can hit it):
+// its Embree id; `local` gets its object-space bounds.
+uint32_t addEmitterShape(EmbreeScene& embree, const Light& l, Bounds3f& local) {
+  std::vector<Vec3f> centres;
+  for (int i = 0; i < l.motion.stepCount(); ++i) centres.push_back(l.motion.step(i).point({0, 0, 0}));
+  switch (l.shape) {
+    case Light::AreaShape::Rect: {
+      TriangleMesh quad = makeQuad(l.size.x, l.size.y);
+      for (Vec3f v : quad.vertices) local.extend(v);
+      return addMesh(embree, l.motion, quad);
+    }
+    case Light::AreaShape::Sphere:
+      local = {Vec3f(-l.radius), Vec3f(l.radius)};
+      return embree.addSphere(centres, l.stepRadius);
+    case Light::AreaShape::Disk:
+      local = {{-l.radius, 0, -l.radius}, {l.radius, 0, l.radius}};
+      return embree.addOrientedDisc(centres, l.stepNormal, l.stepRadius);
+    case Light::AreaShape::Mesh: {
+      TriangleMesh m{l.mesh->vertices, l.mesh->indices};
+      if (!l.motion.moving()) return embree.addTriangles(m.vertices, m.indices);  // world vertices
+      for (Vec3f v : m.vertices) local.extend(v);
+      return addMesh(embree, l.motion, m);
+    }
+  }
+  return ~0u;
+}
+
+// The emitter's Embree id; `swept` gets its world bounds over the shutter.
+uint32_t addEmitterGeometry(EmbreeScene& embree, const Light& l, Bounds3f& swept) {
+  Bounds3f local;
+  uint32_t id = addEmitterShape(embree, l, local);
+  if (l.shape == Light::AreaShape::Mesh && !l.motion.moving()) {
+    for (Vec3f v : l.mesh->vertices) swept.extend(v);
+  } else {
+    swept = l.motion.sweptBounds(local);
+  }
+  return id;
 }
 
 }  // namespace
@@ -264,12 +364,10 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
     if (l.motion.moving()) s.hasMotion = true;
     if (l.type == Light::Type::Area) {
       // The emitter is geometry too: camera and BSDF rays can hit it.
-      TriangleMesh quad = makeQuad(l.size.x, l.size.y);
       s.geometryOwner_.push_back(-int32_t(s.lights.size()) - 1);
-      l.geometryId = addMesh(s.embree_, l.motion, quad);
-      Bounds3f local;
-      for (Vec3f v : quad.vertices) local.extend(v);
-      Bounds3f swept = l.motion.sweptBounds(local);
+      Bounds3f swept;
+      l.geometryId = addEmitterGeometry(s.embree_, l, swept);
+      TDPM_ASSERT(l.geometryId + 1 == s.geometryOwner_.size(), "geometry ids out of order");
       s.bounds.extend(swept);
       if (l.motion.moving()) s.movingBounds.push_back(swept);
     } else if (l.type == Light::Type::Environment) {

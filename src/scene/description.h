@@ -109,7 +109,15 @@ struct LightDesc {
   Vec3f direction{0, -1, 0};   // spot axis, directional travel direction (normalised)
   float coneAngle = 30.0f;     // spot: total half-angle (degrees), (0, 90]
   float falloffStart = 25.0f;  // spot: half-angle where falloff begins, <= coneAngle
-  Vec2f areaSize{1, 1};        // area: rectangle in the local x-z plane, emits toward local -y
+  // Area lights of every shape are Type::Area; JSON names them "area"
+  // (rectangle), "sphere", "disk" and "mesh".
+  enum class AreaShape { Rect, Sphere, Disk, Mesh };
+  AreaShape areaShape = AreaShape::Rect;
+  Vec2f areaSize{1, 1};        // area rect: in the local x-z plane, emits toward local -y
+  float radius = 1.0f;         // sphere (emits outward), disk (local x-z plane, emits toward -y)
+  ShapeDesc mesh;              // mesh: file, vertices, indices, loopLevels (type Mesh); ccw side emits
+  bool twoSided = false;       // area: both sides emit, power split equally
+  bool reverseOrientation = false;  // area: the other side emits (sphere: inward)
   TransformDesc placement;     // area: its placement; environment: light-to-world
                                // (translation ignored); others: identity unless given
   MotionDesc motion;           // any light but an environment may move

@@ -277,6 +277,31 @@ uint32_t EmbreeScene::addQuadric(const Quadric& shape, const Motion& motion) {
   return impl_->record(Impl::kQuadrics, e, swept);
 }
 
+uint32_t EmbreeScene::addOrientedDisc(const std::vector<Vec3f>& centres, const std::vector<Vec3f>& normals,
+                                      const std::vector<float>& radii) {
+  TDPM_ASSERT(!centres.empty() && centres.size() == radii.size() && centres.size() == normals.size(), "bad disc input");
+  RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
+  rtcSetGeometryTimeStepCount(g, unsigned(centres.size()));
+  Bounds3f swept;
+  for (size_t s = 0; s < centres.size(); ++s) {
+    auto* v = static_cast<float*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, unsigned(s), RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
+    auto* n = static_cast<float*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_NORMAL, unsigned(s), RTC_FORMAT_FLOAT3, 3 * sizeof(float), 1));
+    if (!v || !n) { rtcReleaseGeometry(g); impl_->check("allocate a disc buffer"); }
+    v[0] = centres[s].x; v[1] = centres[s].y; v[2] = centres[s].z; v[3] = radii[s];
+    n[0] = normals[s].x; n[1] = normals[s].y; n[2] = normals[s].z;
+    Vec3f r(std::fabs(radii[s]));
+    swept.extend(centres[s] - r);
+    swept.extend(centres[s] + r);
+  }
+  rtcCommitGeometry(g);
+  uint32_t e = rtcAttachGeometry(impl_->layers[Impl::kSpheres].scene, g);
+  rtcReleaseGeometry(g);
+  impl_->check("add a disc");
+  return impl_->record(Impl::kSpheres, e, swept);
+}
+
 void EmbreeScene::commit() {
   for (Impl::Layer& l : impl_->layers) {
     rtcCommitScene(l.scene);

@@ -42,6 +42,11 @@ class EmbreeScene {
   // One disk or cylinder (scene/quadric.h) under `motion` (still or moving):
   // Embree user geometry whose callbacks take each ray into object space.
   uint32_t addQuadric(const Quadric& shape, const Motion& motion);
+
+  // One disc (a disk area light): centre, unit normal and radius per time
+  // step, in the sphere layer (Embree's oriented disc points).
+  uint32_t addOrientedDisc(const std::vector<Vec3f>& centres, const std::vector<Vec3f>& normals,
+                           const std::vector<float>& radii);
   void commit();
 
   // time01: normalised shutter time in [0,1].

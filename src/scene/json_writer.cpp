@@ -155,8 +155,16 @@ std::string objText(const scene::ShapeDesc& s) {
   return out;
 }
 
-const char* lightType(scene::LightDesc::Type t) {
-  switch (t) {
+const char* lightType(const scene::LightDesc& l) {
+  if (l.type == scene::LightDesc::Type::Area) {
+    switch (l.areaShape) {
+      case scene::LightDesc::AreaShape::Rect: return "area";
+      case scene::LightDesc::AreaShape::Sphere: return "sphere";
+      case scene::LightDesc::AreaShape::Disk: return "disk";
+      case scene::LightDesc::AreaShape::Mesh: return "mesh";
+    }
+  }
+  switch (l.type) {
     case scene::LightDesc::Type::Point: return "point";
     case scene::LightDesc::Type::Spot: return "spot";
     case scene::LightDesc::Type::Directional: return "directional";
@@ -272,7 +280,7 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
   root["objects"] = objects;
   Json lights = Json::array();
   for (const auto& l : sc.lights) {
-    Json j{{"type", lightType(l.type)}, {"name", l.name}};
+    Json j{{"type", lightType(l)}, {"name", l.name}};
     switch (l.type) {
       case scene::LightDesc::Type::Point: j["position"] = vec(l.position); j["power"] = rgb(l.power); break;
       case scene::LightDesc::Type::Spot:
@@ -287,7 +295,20 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
         j["irradiance"] = rgb(l.power);
         break;
       case scene::LightDesc::Type::Area:
-        j["size"] = Json::array({num(l.areaSize.x), num(l.areaSize.y)});
+        switch (l.areaShape) {
+          case scene::LightDesc::AreaShape::Rect: j["size"] = Json::array({num(l.areaSize.x), num(l.areaSize.y)}); break;
+          case scene::LightDesc::AreaShape::Sphere:
+          case scene::LightDesc::AreaShape::Disk: j["radius"] = num(l.radius); break;
+          case scene::LightDesc::AreaShape::Mesh: {
+            std::string name = stem + ".mesh" + std::to_string(out.meshFiles.size()) + ".obj";
+            out.meshFiles.push_back({(jp.parent_path() / name).string(), meshText ? objText(l.mesh) : std::string()});
+            j["file"] = name;
+            if (l.mesh.loopLevels >= 0) j["subdivision"] = Json{{"scheme", "loop"}, {"levels", l.mesh.loopLevels}};
+            break;
+          }
+        }
+        if (l.twoSided) j["two_sided"] = true;
+        if (l.reverseOrientation) j["reverse_orientation"] = true;
         j["power"] = rgb(l.power);
         break;
       case scene::LightDesc::Type::Environment:

@@ -1,4 +1,5 @@
-// scene/light.cpp — light constants and next-event sampling.
+// scene/light.cpp — light constants, next-event sampling and photon emission
+// (area lights' shapes: scene/area_light.cpp).
 #include "scene/light.h"
 
 #include <cmath>
@@ -16,19 +17,6 @@ float Light::spotFalloff(float cosTheta) const {
   return (d * d) * (d * d);
 }
 
-namespace {
-AreaLightFrame computeAreaLightFrame(const Light& light, float time01) {
-  Affine3f m = light.motion.atNormalized(time01);
-  AreaLightFrame f;
-  f.center = m.point({0, 0, 0});
-  f.edgeX = m.vector({light.size.x, 0, 0});
-  f.edgeZ = m.vector({0, 0, light.size.y});
-  Vec3f c = cross(f.edgeZ, f.edgeX);  // local (0,0,1) x (1,0,0) = +y; emitting side is -y
-  f.area = length(c);
-  f.normal = f.area > 0 ? -c / f.area : Vec3f(0, -1, 0);
-  return f;
-}
-}  // namespace
 
 void finalizeLight(Light& light) {
   switch (light.type) {
@@ -62,19 +50,6 @@ void finalizeLight(Light& light) {
 AreaLightFrame areaLightFrame(const Light& light, float time01) {
   if (light.hasStillFrame) return light.stillFrame;
   return computeAreaLightFrame(light, time01);
-}
-
-Rgb areaLightRadiance(const Light& light, const AreaLightFrame& f, Vec3f dirFromLight) {
-  if (dot(f.normal, dirFromLight) <= 0 || !(f.area > 0)) return Rgb(0.0f);
-  return light.power / (kPi * f.area);  // Lambertian emitter: Phi = L * pi * A
-}
-
-float areaLightPdf(const Light& /*light*/, const AreaLightFrame& f, Vec3f p, Vec3f hit) {
-  Vec3f d = hit - p;
-  float dist2 = lengthSquared(d);
-  float cosL = std::fabs(dot(f.normal, d)) / std::sqrt(dist2);
-  if (cosL <= 0 || !(f.area > 0)) return 0.0f;
-  return dist2 / (cosL * f.area);
 }
 
 namespace {
@@ -117,15 +92,7 @@ bool sampleLight(const Light& light, Vec3f p, float time01, Vec2f u, LightSample
       out.pdf = 1.0f;
       return true;
     }
-    case Light::Type::Area: {
-      AreaLightFrame f = areaLightFrame(light, time01);
-      Vec3f q = f.center + f.edgeX * (u.x - 0.5f) + f.edgeZ * (u.y - 0.5f);
-      if (!aimAt(p, q, out)) return false;
-      out.li = areaLightRadiance(light, f, -out.wi);
-      if (out.li.isBlack()) return false;
-      out.pdf = areaLightPdf(light, f, p, q);
-      return out.pdf > 0;
-    }
+    case Light::Type::Area: return sampleAreaLight(light, areaLightFrame(light, time01), p, u, out);
     case Light::Type::Environment:
       out.distance = std::numeric_limits<float>::infinity();
       return light.env->sample(u, out.wi, out.li, out.pdf);
@@ -191,16 +158,7 @@ bool emitFromLight(const Light& light, float time01, const Bounds3f& sceneBounds
       out.flux = light.power * (kPi * r * r);
       return true;
     }
-    case Light::Type::Area: {
-      AreaLightFrame fr = areaLightFrame(light, time01);
-      if (!(fr.area > 0)) return false;
-      Frame f(fr.normal);
-      out.origin = fr.center + fr.edgeX * (uPos.x - 0.5f) + fr.edgeZ * (uPos.y - 0.5f);
-      out.direction = f.toWorld(squareToCosineHemisphere(uDir));
-      // L * A * pi = power: cosine-weighted directions, uniform positions.
-      out.flux = light.power;
-      return true;
-    }
+    case Light::Type::Area: return emitFromAreaLight(light, areaLightFrame(light, time01), uPos, uDir, out);
     case Light::Type::Environment: {
       // A direction toward the sky by the map's luminance, then a point on
       // the disc of the bounding sphere perpendicular to it, outside the

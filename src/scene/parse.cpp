@@ -728,7 +728,10 @@ const std::vector<LightKind>& lightKinds() {
       {"point", LightDesc::Type::Point, {"position", "power"}},
       {"spot", LightDesc::Type::Spot, {"position", "target", "direction", "cone_angle", "falloff_start", "power"}},
       {"directional", LightDesc::Type::Directional, {"direction", "irradiance"}},
-      {"area", LightDesc::Type::Area, {"size", "power"}},
+      {"area", LightDesc::Type::Area, {"size", "power", "two_sided", "reverse_orientation"}},
+      {"sphere", LightDesc::Type::Area, {"radius", "power", "two_sided", "reverse_orientation"}},
+      {"disk", LightDesc::Type::Area, {"radius", "power", "two_sided", "reverse_orientation"}},
+      {"mesh", LightDesc::Type::Area, {"file", "subdivision", "power", "two_sided", "reverse_orientation"}},
       {"environment", LightDesc::Type::Environment, {"L", "filename", "mapping", "scale"}},
   };
   return kinds;
@@ -791,6 +794,92 @@ void readEnvironment(const Node& n, const std::string& sceneDir, LightDesc* l) {
   l->map = std::move(map);
 }
 
+bool readBool(const Node& n) {
+  n.require(n.json().is_boolean(), "expected true or false");
+  return n.json().get<bool>();
+}
+
+// A sphere, disk or mesh emitter's shape (the "area" rectangle reads "size").
+void readEmitterShape(const Node& n, const std::string& typeName, const std::string& sceneDir, LightDesc* l) {
+  if (typeName == "sphere") l->areaShape = LightDesc::AreaShape::Sphere;
+  if (typeName == "disk") l->areaShape = LightDesc::AreaShape::Disk;
+  if (typeName == "mesh") {
+    l->areaShape = LightDesc::AreaShape::Mesh;
+    l->mesh.type = ShapeDesc::Type::Mesh;
+    readMesh(n, sceneDir, &l->mesh);
+    n.member("file").require(!l->mesh.indices.empty(), "an emissive mesh needs at least one triangle");
+  }
+  if (n.has("radius")) {
+    l->radius = readPositive(n.member("radius"), "radius");
+    checkPoint(n.member("radius"), Vec3f(l->radius), "radius");
+  }
+  if (n.has("two_sided")) l->twoSided = readBool(n.member("two_sided"));
+  if (n.has("reverse_orientation")) l->reverseOrientation = readBool(n.member("reverse_orientation"));
+}
+
+// The emitter's object-space box and, at each motion step, its area after
+// the transform (checked > 1e-30 m^2 and finite). A sphere must scale
+// uniformly, a disk alike along x and z (Embree's spheres and discs are
+// round); a moving mesh may change size only uniformly (scene/light.h).
+Bounds3f checkEmitterShape(const Node& n, const LightDesc& l, const Motion& m) {
+  Bounds3f local;
+  const char* where = l.areaShape == LightDesc::AreaShape::Mesh ? "file" : l.areaShape == LightDesc::AreaShape::Rect ? "size" : "radius";
+  // Shapes by the poses' scales (the motion's steps blend rotations, which
+  // shortens their axes slightly and unequally: not a change of shape).
+  std::vector<Vec3f> scales = {l.placement.scale};
+  for (const TransformDesc& k : l.motion.poses) scales.push_back(k.scale * l.placement.scale);
+  Node at = n.has("motion") ? n.member("motion") : memberOr(n, "transform");
+  for (size_t i = 0; i < scales.size(); ++i) {
+    if (i == 0 && !l.motion.empty()) continue;  // the keys' products are what moves
+    Vec3f sc{std::fabs(scales[i].x), std::fabs(scales[i].y), std::fabs(scales[i].z)};
+    if (l.areaShape == LightDesc::AreaShape::Sphere)
+      at.require(std::fabs(sc.x - sc.y) <= 1e-5f * sc.x && std::fabs(sc.x - sc.z) <= 1e-5f * sc.x,
+                 "a sphere light must scale uniformly (an ellipsoid is not supported), got scale " + formatVec(scales[i]));
+    if (l.areaShape == LightDesc::AreaShape::Disk)
+      at.require(std::fabs(sc.x - sc.z) <= 1e-5f * sc.x,
+                 "a disk light must scale alike along its local x and z (an ellipse is not supported), got " +
+                     fmt(sc.x) + " and " + fmt(sc.z));
+    if (l.areaShape == LightDesc::AreaShape::Mesh && i > 1) {
+      // Relative triangle areas must stay those of the first key.
+      Vec3f s0 = l.motion.poses[0].scale, si = l.motion.poses[i - 1].scale;
+      Vec3f k{si.x / s0.x, si.y / s0.y, si.z / s0.z};
+      at.require(std::fabs(k.x - k.y) <= 1e-5f * std::fabs(k.x) && std::fabs(k.x - k.z) <= 1e-5f * std::fabs(k.x),
+                 "a moving mesh light may change its size only uniformly (its triangles' relative areas must stay fixed)");
+    }
+  }
+  for (int i = 0; i < m.stepCount(); ++i) {
+    const Affine3f& a = m.step(i);
+    float lx = length(a.vector({1, 0, 0})), lz = length(a.vector({0, 0, 1}));
+    float area = 0;
+    switch (l.areaShape) {
+      case LightDesc::AreaShape::Rect:
+        area = length(cross(a.vector({0, 0, l.areaSize.y}), a.vector({l.areaSize.x, 0, 0})));
+        break;
+      case LightDesc::AreaShape::Sphere: area = 4.0f * kPi * l.radius * l.radius * lx * lx; break;
+      case LightDesc::AreaShape::Disk: area = kPi * l.radius * l.radius * lx * lz; break;
+      case LightDesc::AreaShape::Mesh:
+        for (size_t t = 0; t + 2 < l.mesh.indices.size(); t += 3) {
+          Vec3f p0 = l.mesh.vertices[l.mesh.indices[t]], p1 = l.mesh.vertices[l.mesh.indices[t + 1]],
+                p2 = l.mesh.vertices[l.mesh.indices[t + 2]];
+          area += 0.5f * length(cross(a.vector(p1 - p0), a.vector(p2 - p0)));
+        }
+        break;
+    }
+    memberOr(n, where).require(area > 1e-30f && std::isfinite(area),
+                               "the light's area " + fmt(area) + " m^2 (after its transform) is too small for float arithmetic");
+  }
+  switch (l.areaShape) {
+    case LightDesc::AreaShape::Rect:
+      local.extend({-0.5f * l.areaSize.x, 0, -0.5f * l.areaSize.y});
+      local.extend({0.5f * l.areaSize.x, 0, 0.5f * l.areaSize.y});
+      break;
+    case LightDesc::AreaShape::Sphere: local.extend(Vec3f(-l.radius)); local.extend(Vec3f(l.radius)); break;
+    case LightDesc::AreaShape::Disk: local.extend({-l.radius, 0, -l.radius}); local.extend({l.radius, 0, l.radius}); break;
+    case LightDesc::AreaShape::Mesh: for (Vec3f v : l.mesh.vertices) local.extend(v); break;
+  }
+  return local;
+}
+
 // Where the renderer will put the light over the shutter (scene/build.cpp,
 // scene/light.cpp): in range, and an area light with a non-zero float area.
 void checkLightPlacement(const Node& n, const LightDesc& l, Shutter s) {
@@ -814,15 +903,8 @@ void checkLightPlacement(const Node& n, const LightDesc& l, Shutter s) {
     checkWorldBounds(n, world, "the light");
     return;
   }
-  Bounds3f local;
-  local.extend({-0.5f * l.areaSize.x, 0, -0.5f * l.areaSize.y});
-  local.extend({0.5f * l.areaSize.x, 0, 0.5f * l.areaSize.y});
+  Bounds3f local = checkEmitterShape(n, l, m);
   checkWorldBounds(n, m.sweptBounds(local), "the light");
-  for (int i = 0; i < m.stepCount(); ++i) {
-    float area = length(cross(m.step(i).vector({0, 0, l.areaSize.y}), m.step(i).vector({l.areaSize.x, 0, 0})));
-    memberOr(n, "size").require(area > 1e-30f && std::isfinite(area),
-                                "the light's area " + fmt(area) + " m^2 (after its transform) is too small for float arithmetic");
-  }
 }
 
 LightDesc readLight(const Node& n, Shutter s, const std::string& sceneDir) {
@@ -852,6 +934,7 @@ LightDesc readLight(const Node& n, Shutter s, const std::string& sceneDir) {
   if (kind.type == LightDesc::Type::Spot) readSpot(n, &l);
   if (kind.type == LightDesc::Type::Environment) readEnvironment(n, sceneDir, &l);
   if (n.has("size")) readAreaSize(n.member("size"), &l);
+  if (kind.type == LightDesc::Type::Area) readEmitterShape(n, typeName, sceneDir, &l);
   if (n.has("transform")) l.placement = readTransform(n.member("transform"));
   if (n.has("motion")) l.motion = readMotion(n.member("motion"), s);
   checkLightPlacement(n, l, s);

@@ -52,7 +52,8 @@ bool Scene::intersect(Vec3f o, Vec3f d, float tFar, float time01, Hit& hit) cons
   if (owner < 0) {
     hit.light = -owner - 1;
     hit.object = 0;
-    hit.n = areaLightFrame(lights[size_t(hit.light)], time01).normal * -1.0f;  // quad's geometric +y side
+    const Light& light = lights[size_t(hit.light)];
+    hit.n = areaLightNormal(light, areaLightFrame(light, time01), hit.p, raw.primitiveId);  // the emitting side
     hit.localP = hit.p;
     return true;
   }
