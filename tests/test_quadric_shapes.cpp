@@ -440,8 +440,9 @@ TEST_CASE("pbrt ReverseOrientation turns a rectangular area light's emitting sid
       "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 1 1 0 0 1 0] "
       "\"integer indices\" [0 1 2 0 2 3]\n";
   auto emitDir = [](const scene::SceneDescription& d) {
-    // The area light emits toward its local -y.
-    return Affine3f::rotate(d.lights.at(0).placement.rotate).vector({0, -1, 0});
+    // The area light emits toward its local -y, or +y when reversed.
+    const scene::LightDesc& l = d.lights.at(0);
+    return Affine3f::rotate(l.placement.rotate).vector({0, l.reverseOrientation ? 1.0f : -1.0f, 0});
   };
   scene::SceneDescription plain = pbrt::importPbrtText("WorldBegin\n" + light, "dir/t.pbrt").scene;
   scene::SceneDescription reversed = pbrt::importPbrtText("WorldBegin\nReverseOrientation\n" + light, "dir/t.pbrt").scene;
