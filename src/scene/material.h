@@ -34,6 +34,9 @@ struct Material {
   Rgb specular{1.0f};        // mirror, metal reflectance; dielectric tint
   float ior = 1.5f;          // dielectric, plastic coating
   float alpha = 0.2f;        // GGX roughness (metal, plastic)
+  // >= 0: the albedo is this node of Scene::textures (evaluated at the hit's
+  // uv, scene/texture.h) instead of `albedo` above.
+  int32_t albedoTexture = -1;
 
   // Purely delta (mirror, glass): no photon is stored here, no light sampling.
   bool isDeltaOnly() const { return type == Type::Mirror || type == Type::Dielectric; }
