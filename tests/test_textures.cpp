@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -232,8 +233,10 @@ TEST_CASE("JSON textures: image (PFM, TGA raw and RLE, PNG sRGB / linear), scale
       "scaled": {"type": "scale", "texture": "img", "scale": "half"},
       "mixed": {"type": "mix", "tex1": "img", "tex2": [1, 1, 1], "amount": 0.25},
       "checks": {"type": "checkerboard", "tex1": "scaled", "tex2": [0, 0, 1], "uscale": 2, "vscale": 2}},
-    "materials": {"m": {"type": "diffuse", "texture": "checks"}, "t": {"type": "diffuse", "texture": "tga"}},
-    "objects": [{"shape": {"type": "quad", "size": [2, 2]}, "material": "m"}])");
+    "materials": {"m": {"type": "diffuse", "texture": "checks"}, "t": {"type": "diffuse", "texture": "tga"},
+                  "chrome": {"type": "metal", "color": "img", "roughness": 0.3}},
+    "objects": [{"shape": {"type": "quad", "size": [2, 2]}, "material": "m"},
+                {"shape": {"type": "quad", "size": [2, 2]}, "material": "chrome", "transform": {"translate": [5, 0, 0]}}])");
   scene::SceneDescription d = scene::parseScene(text, dir + "/s.json");
   REQUIRE(d.textures.size() == 6);
   // The PFM is read once though two textures could name it; each image once in the built set.
@@ -252,6 +255,16 @@ TEST_CASE("JSON textures: image (PFM, TGA raw and RLE, PNG sRGB / linear), scale
   // checkerboard: floor(2u) + floor(2v): (0.25, 0.25) even -> scaled; (0.75, 0.25) odd -> blue.
   checkRgb(s->textures.eval(idx("checks"), {{0.25f, 0.25f}, {}}), Rgb(0.1f, 0.2f, 0.3f));
   checkRgb(s->textures.eval(idx("checks"), {{0.75f, 0.25f}, {}}), Rgb(0, 0, 1));
+  // Textured specular colour: the metal's reflectance is the image at the hit's (u, v).
+  Hit h;
+  REQUIRE(s->intersect({5.5f, 2, 0}, {0, -1, 0}, 10.0f, 0.0f, h));  // u = 0.75
+  const Material& base = s->materials[s->objects[h.object].material];
+  std::optional<Material> scratch;
+  checkRgb(s->shadedMaterial(base, h, scratch).specular, Rgb(0.8f, 0.6f, 0.4f));
+  Hit h0;
+  REQUIRE(s->intersect({-0.5f, 2, 0}, {0, -1, 0}, 10.0f, 0.0f, h0));
+  const Material& diffuse = s->materials[s->objects[h0.object].material];
+  CHECK(&s->shadedMaterial(diffuse, h0, scratch) == &diffuse);  // untextured specular: no copy
   std::filesystem::remove_all(dir);
 }
 
@@ -306,12 +319,18 @@ Material "matte" "texture Kd" "img"
 Translate 0 0.5 0
 Shape "sphere" "float radius" 0.3
 AttributeEnd
+AttributeBegin
+Material "mirror" "texture Kr" "m"
+Translate 0.6 0.3 0.4
+Shape "sphere" "float radius" 0.2
+AttributeEnd
 )";
   test::writeFile(dir + "/s.pbrt", text);
   pbrt::ImportResult r = pbrt::importPbrtFile(dir + "/s.pbrt");
   scene::SceneDescription& d = r.scene;
   REQUIRE(d.textures.size() == 4);
-  REQUIRE(d.objects.size() == 2);
+  REQUIRE(d.objects.size() == 3);
+  CHECK(d.materials[d.objects[2].material].specularTexture == 2);  // "m"
   CHECK(d.objects[0].shape.uvs.size() == 6);
   // The image file is read once though two materials use it.
   auto built = Scene::build(d);

@@ -127,9 +127,9 @@ class Importer {
   scene::TexInput texInput(const ParamSet& ps, const std::string& name, bool isFloat, Rgb fallback, const Loc& at,
                            const std::string& what) const;
   void imageTexture(scene::TextureDef& t, const ParamSet& ps, const Loc& at, const std::string& what);
-  // A reflectance that may be any spectrum texture: sets m.albedoTexture
-  // (a non-constant texture) or returns the value.
-  Rgb albedoParam(const ParamSet& ps, const std::string& name, Rgb fallback, scene::MaterialDesc& m) const;
+  // A reflectance that may be any spectrum texture: sets *index (a texture
+  // that varies; the value returned is then a placeholder) or returns the value.
+  Rgb textureParam(const ParamSet& ps, const std::string& name, Rgb fallback, int32_t* index) const;
   uint32_t materialIndex(int slot);
   std::string uniqueMaterialName(const std::string& base);
   Rgb color(const ParamSet& ps, const std::string& name, Rgb fallback) const;

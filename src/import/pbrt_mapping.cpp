@@ -42,8 +42,8 @@ Rgb Importer::color(const ParamSet& ps, const std::string& name, Rgb fallback) c
     auto it = textures_.find(p->strings[0]);
     if (it == textures_.end()) ps.fail(*p, "no texture named \"" + p->strings[0] + "\" has been defined");
     if (!it->second.constant)
-      ps.fail(*p, "a texture that varies is supported only as the diffuse reflectance (Kd of matte and plastic, "
-                  "reflectance of diffuse and coateddiffuse); here only a constant texture is");
+      ps.fail(*p, "a texture that varies is supported only as a reflectance (Kd of matte and plastic, reflectance of "
+                  "diffuse, coateddiffuse and conductor, Kr of mirror, Kr = Kt of glass); here only a constant texture is");
     return it->second.value;
   }
   if (p->type == "spectrum" || p->type == "blackbody") return spectrumColor(ps, *p);
@@ -191,14 +191,14 @@ void Importer::texture(const std::string& name, const std::string& kind, const s
   textures_[name] = v;
 }
 
-Rgb Importer::albedoParam(const ParamSet& ps, const std::string& name, Rgb fallback, scene::MaterialDesc& m) const {
+Rgb Importer::textureParam(const ParamSet& ps, const std::string& name, Rgb fallback, int32_t* index) const {
   const Param* p = ps.find(name);
   if (p && p->type == "texture" && p->strings.size() == 1) {
     auto it = textures_.find(p->strings[0]);
     if (it != textures_.end() && !it->second.constant) {
       p->used = true;
       if (it->second.isFloat) ps.fail(*p, "texture \"" + p->strings[0] + "\" is a float texture, but a reflectance needs a spectrum one");
-      m.albedoTexture = it->second.index;
+      *index = it->second.index;
       return Rgb(0.5f);  // not used: the texture is (clamped to [0, 1] when evaluated)
     }
   }
@@ -235,12 +235,12 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
   } else if (type == "matte" || type == "diffuse") {
     m.type = T::Diffuse;
     std::string key = type == "matte" ? "Kd" : "reflectance";
-    m.albedo.color = albedoParam(ps, key, Rgb(0.5f), m);
+    m.albedo.color = textureParam(ps, key, Rgb(0.5f), &m.albedoTexture);
     checkReflectance(ps, key, m.albedo.color);
     if (type == "matte" && floatParam(ps, "sigma", 0) != 0) failAt(at, label + ": Oren-Nayar roughness (sigma > 0) is not supported");
   } else if (type == "mirror") {
     m.type = T::Mirror;
-    m.specular = color(ps, "Kr", Rgb(0.9f));
+    m.specular = textureParam(ps, "Kr", Rgb(0.9f), &m.specularTexture);
     checkReflectance(ps, "Kr", m.specular);
   } else if (type == "glass" || type == "dielectric") {
     m.type = T::Dielectric;
@@ -251,8 +251,10 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     roughness(type == "glass", 0, &alpha);
     if (alpha != 0) failAt(at, label + ": rough glass is not supported (roughness must be 0)");
     if (type == "glass") {
-      Rgb kr = color(ps, "Kr", Rgb(1.0f)), kt = color(ps, "Kt", Rgb(1.0f));
-      if (kr.r != kt.r || kr.g != kt.g || kr.b != kt.b)
+      int32_t tr = -1, tt = -1;
+      Rgb kr = textureParam(ps, "Kr", Rgb(1.0f), &tr), kt = textureParam(ps, "Kt", Rgb(1.0f), &tt);
+      m.specularTexture = tr;
+      if (tr != tt || kr.r != kt.r || kr.g != kt.g || kr.b != kt.b)
         failAt(at, label + ": Kr and Kt differ; tdpm's dielectric has one tint for reflection and transmission");
       checkReflectance(ps, "Kr", kr);
       m.specular = kr;
@@ -261,7 +263,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     bool v3 = type == "metal";
     Rgb r0;
     if (!v3 && ps.has("reflectance")) {
-      r0 = color(ps, "reflectance", Rgb(1.0f));
+      r0 = textureParam(ps, "reflectance", Rgb(1.0f), &m.specularTexture);
     } else {
       // pbrt's default is copper (pbrt_spectrum.cpp: v3 reduces its copper
       // against equal-energy white, v4 its metal-Cu under D65).
@@ -288,7 +290,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     bool v3 = type == "plastic";
     m.type = T::Plastic;
     std::string key = v3 ? "Kd" : "reflectance";
-    m.albedo.color = albedoParam(ps, key, Rgb(v3 ? 0.25f : 0.5f), m);
+    m.albedo.color = textureParam(ps, key, Rgb(v3 ? 0.25f : 0.5f), &m.albedoTexture);
     checkReflectance(ps, key, m.albedo.color);
     double alpha;
     roughness(v3, v3 ? 0.1 : 0.0, &alpha);

@@ -86,7 +86,8 @@ Material toMaterial(const scene::MaterialDesc& d) {
   m.albedo.a = d.albedo.color;
   m.albedo.b = d.albedo.color2;
   m.albedo.invScale = 1.0f / d.albedo.scale;
-  m.albedoTexture = d.albedoTexture;  // node i of the TextureSet is desc.textures[i]
+  m.albedoTexture = d.albedoTexture;
+  m.specularTexture = d.specularTexture;  // node i of the TextureSet is desc.textures[i]
   m.specular = d.specular;
   m.ior = d.ior;
   // Keep GGX away from alpha -> 0, where D is a numerically unstable spike.

@@ -95,6 +95,9 @@ struct MaterialDesc {
   // Diffuse / plastic: a named texture (index into SceneDescription::
   // textures, a spectrum one) that replaces albedo when >= 0.
   int32_t albedoTexture = -1;
+  // Mirror, metal, dielectric (and pbrt's glass): a spectrum texture for
+  // `specular` when >= 0.
+  int32_t specularTexture = -1;
 };
 
 struct ShapeDesc {

@@ -156,11 +156,12 @@ Json material(const scene::MaterialDesc& m, const std::vector<std::string>& text
     else if (m.albedo.kind == scene::TextureDesc::Kind::Constant) j["color"] = rgb(m.albedo.color);
     else j["texture"] = texture(m.albedo);
   };
+  Json spec = m.specularTexture >= 0 ? Json(textures.at(size_t(m.specularTexture))) : rgb(m.specular);
   switch (m.type) {
     case T::Diffuse: j["type"] = "diffuse"; albedo(); break;
-    case T::Mirror: j["type"] = "mirror"; j["color"] = rgb(m.specular); break;
-    case T::Dielectric: j["type"] = "dielectric"; j["ior"] = num(m.ior); j["tint"] = rgb(m.specular); break;
-    case T::Metal: j["type"] = "metal"; j["color"] = rgb(m.specular); j["roughness"] = num(m.roughness); break;
+    case T::Mirror: j["type"] = "mirror"; j["color"] = spec; break;
+    case T::Dielectric: j["type"] = "dielectric"; j["ior"] = num(m.ior); j["tint"] = spec; break;
+    case T::Metal: j["type"] = "metal"; j["color"] = spec; j["roughness"] = num(m.roughness); break;
     case T::Plastic:
       j["type"] = "plastic";
       albedo();

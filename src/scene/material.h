@@ -37,6 +37,10 @@ struct Material {
   // >= 0: the albedo is this node of Scene::textures (evaluated at the hit's
   // uv, scene/texture.h) instead of `albedo` above.
   int32_t albedoTexture = -1;
+  // >= 0: `specular` (mirror / metal reflectance, dielectric tint) is this
+  // node at the hit (Scene::shadedMaterial). Classification (isGlossy, ...)
+  // does not depend on it.
+  int32_t specularTexture = -1;
 
   // Purely delta (mirror, glass): no photon is stored here, no light sampling.
   bool isDeltaOnly() const { return type == Type::Mirror || type == Type::Dielectric; }

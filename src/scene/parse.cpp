@@ -606,9 +606,20 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader*
   m.name = name;
   m.type = kind.type;
   bool albedo = kind.type == MaterialDesc::Type::Diffuse || kind.type == MaterialDesc::Type::Plastic;
+  // A specular colour: a reflectance, or the name of a spectrum texture.
+  auto specular = [&](const Node& c) {
+    if (!c.json().is_string()) {
+      m.specular = readReflectance(c);
+      return;
+    }
+    if (!textures) c.fail("unknown texture \"" + c.string() + "\"; no textures are defined");
+    m.specularTexture = textures->index(c.string(), c);
+    if ((*textures->out())[size_t(m.specularTexture)].isFloat)
+      c.fail("texture \"" + c.string() + "\" is a float texture, but a spectrum (RGB) one is expected here");
+  };
   if (albedo) m.albedo = readAlbedo(n, textures, &m.albedoTexture);
-  else if (n.has("color")) m.specular = readReflectance(n.member("color"));
-  if (n.has("tint")) m.specular = readReflectance(n.member("tint"));
+  else if (n.has("color")) specular(n.member("color"));
+  if (n.has("tint")) specular(n.member("tint"));
   if (n.has("ior")) m.ior = readIor(n.member("ior"));
   if (n.has("roughness")) m.roughness = readRoughness(n.member("roughness"));
   return m;

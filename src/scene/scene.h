@@ -5,6 +5,7 @@
 #pragma once
 #include <algorithm>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,16 @@ class Scene {
     if (m.albedoTexture < 0) return m.albedo.at(hit.localP);
     Rgb v = textures.eval(uint32_t(m.albedoTexture), {uvAt(hit), hit.localP});
     return {std::clamp(v.r, 0.0f, 1.0f), std::clamp(v.g, 0.0f, 1.0f), std::clamp(v.b, 0.0f, 1.0f)};
+  }
+  // The material the BSDF sees at the hit: m itself, or (a textured
+  // specular colour) a copy in `scratch` with the value at the hit, clamped
+  // to [0, 1]. An empty optional costs an untextured hit nothing.
+  const Material& shadedMaterial(const Material& m, const Hit& hit, std::optional<Material>& scratch) const {
+    if (m.specularTexture < 0) return m;
+    Rgb v = textures.eval(uint32_t(m.specularTexture), {uvAt(hit), hit.localP});
+    scratch.emplace(m);
+    scratch->specular = {std::clamp(v.r, 0.0f, 1.0f), std::clamp(v.g, 0.0f, 1.0f), std::clamp(v.b, 0.0f, 1.0f)};
+    return *scratch;
   }
   // The raw ray tracer (benchmarks compare our tracing against it).
   const EmbreeScene& embree() const { return embree_; }
