@@ -394,3 +394,37 @@ TEST_CASE("texture bad input: located errors (JSON and pbrt), and convert writes
   CHECK(!test::fileExists(dir + "/c.json"));
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("pbrt uv: a rotated sphere keeps pbrt's (u, v) at its object-space points; PLY u/v reach the mesh") {
+  // Rotate 90 about x takes pbrt's object (0,0,1) (v = 1), (1,0,0) (u = 0,
+  // v = 1/2) and (0,1,0) (u = 1/4) to world (0,-1,0), (1,0,0), (0,0,1);
+  // tdpm's world is pbrt's mirrored in x.
+  scene::SceneDescription d = pbrt::importPbrtText("WorldBegin\nRotate 90 1 0 0\nShape \"sphere\"\n", "dir/t.pbrt").scene;
+  auto s = Scene::build(d);
+  auto uvToward = [&](Vec3f p) {
+    Hit h;
+    REQUIRE(s->intersect(p * 3.0f, p * -1.0f, 10.0f, 0.0f, h));
+    return s->uvAt(h);
+  };
+  CHECK(uvToward({0, -1, 0}).y == doctest::Approx(1.0f).epsilon(1e-4));
+  Vec2f a = uvToward({-1, 0, 0});
+  CHECK(std::fmod(a.x + 0.5f, 1.0f) == doctest::Approx(0.5f).epsilon(1e-4));  // u = 0 (or 1 at the seam)
+  CHECK(a.y == doctest::Approx(0.5f).epsilon(1e-4));
+  CHECK(uvToward({0, 0, 1}).x == doctest::Approx(0.25f).epsilon(1e-4));
+
+  std::string dir = test::makeTempDir();
+  test::writeFile(dir + "/m.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                                  "property float u\nproperty float v\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                  "0 0 0 0 0\n1 0 0 0.5 0\n1 0 1 0.5 0.25\n0 0 1 0 0.25\n4 0 3 2 1\n");
+  test::writeFile(dir + "/p.pbrt", "WorldBegin\nShape \"plymesh\" \"string filename\" \"m.ply\"\n");
+  scene::SceneDescription q = pbrt::importPbrtFile(dir + "/p.pbrt").scene;
+  REQUIRE(q.objects.size() == 1);
+  const scene::ShapeDesc& m = q.objects[0].shape;
+  REQUIRE(m.uvs.size() == m.indices.size());
+  for (size_t k = 0; k < m.indices.size(); ++k) {
+    Vec3f v = m.vertices[m.indices[k]];  // tdpm x = -pbrt x
+    CHECK(m.uvs[k].x == doctest::Approx(-0.5f * v.x));
+    CHECK(m.uvs[k].y == doctest::Approx(0.25f * v.z));
+  }
+  std::filesystem::remove_all(dir);
+}
