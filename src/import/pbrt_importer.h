@@ -124,7 +124,7 @@ class Importer {
   };
   MotionPlan planMotion(const Mat ctm[2], const Loc& at, const std::string& what) const;
   // A texture statement's input parameter `name` (a texture, or a value).
-  scene::TexInput texInput(const ParamSet& ps, const std::string& name, bool isFloat, Rgb fallback, const Loc& at,
+  scene::TexInput texInput(const ParamSet& ps, const std::string& name, bool isFloat, Rgb fallback,
                            const std::string& what) const;
   void imageTexture(scene::TextureDef& t, const ParamSet& ps, const Loc& at, const std::string& what);
   // A reflectance that may be any spectrum texture: sets *index (a texture

@@ -65,7 +65,7 @@ double Importer::floatParam(const ParamSet& ps, const std::string& name, double 
 }
 
 scene::TexInput Importer::texInput(const ParamSet& ps, const std::string& name, bool isFloat, Rgb fallback,
-                                   const Loc& at, const std::string& what) const {
+                                   const std::string& what) const {
   scene::TexInput in;
   in.value = fallback;
   const Param* p = ps.find(name);
@@ -82,7 +82,6 @@ scene::TexInput Importer::texInput(const ParamSet& ps, const std::string& name, 
     return in;
   }
   in.value = isFloat ? Rgb(float(floatParam(ps, name, fallback.r))) : color(ps, name, fallback);
-  (void)at;
   return in;
 }
 
@@ -158,24 +157,24 @@ void Importer::texture(const std::string& name, const std::string& kind, const s
   } else if (type == "scale") {
     t.kind = scene::TextureDef::Kind::Scale;
     if (ps.has("tex1") || ps.has("tex2")) {  // pbrt-v3: tex1 x tex2
-      t.a = texInput(ps, "tex1", isFloat, Rgb(1.0f), at, what);
-      t.b = texInput(ps, "tex2", isFloat, Rgb(1.0f), at, what);
+      t.a = texInput(ps, "tex1", isFloat, Rgb(1.0f), what);
+      t.b = texInput(ps, "tex2", isFloat, Rgb(1.0f), what);
     } else {
-      t.a = texInput(ps, "tex", isFloat, Rgb(1.0f), at, what);
-      t.b = texInput(ps, "scale", true, Rgb(1.0f), at, what + "'s scale");
+      t.a = texInput(ps, "tex", isFloat, Rgb(1.0f), what);
+      t.b = texInput(ps, "scale", true, Rgb(1.0f), what + "'s scale");
     }
   } else if (type == "mix") {
     t.kind = scene::TextureDef::Kind::Mix;
-    t.a = texInput(ps, "tex1", isFloat, Rgb(0.0f), at, what);
-    t.b = texInput(ps, "tex2", isFloat, Rgb(1.0f), at, what);
-    t.amount = texInput(ps, "amount", true, Rgb(0.5f), at, what + "'s amount");
+    t.a = texInput(ps, "tex1", isFloat, Rgb(0.0f), what);
+    t.b = texInput(ps, "tex2", isFloat, Rgb(1.0f), what);
+    t.amount = texInput(ps, "amount", true, Rgb(0.5f), what + "'s amount");
   } else if (type == "checkerboard") {
     if (ps.getInt("dimension", 2) != 2)
       failAt(at, what + ": a 3D checkerboard is not supported (dimension 2 only: pbrt's 3D one lives in the texture's own space)");
     t.kind = scene::TextureDef::Kind::Checkerboard;
     mapping();
-    t.a = texInput(ps, "tex1", isFloat, Rgb(1.0f), at, what);
-    t.b = texInput(ps, "tex2", isFloat, Rgb(0.0f), at, what);
+    t.a = texInput(ps, "tex1", isFloat, Rgb(1.0f), what);
+    t.b = texInput(ps, "tex2", isFloat, Rgb(0.0f), what);
     for (const char* q : {"aamode", "filter"})
       if (ps.has(q)) ps.markUsed(q);
     note(at, what + ": the checkerboard's antialiasing filter is not applied (tdpm supersamples instead)");
