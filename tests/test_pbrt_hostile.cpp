@@ -429,8 +429,8 @@ TEST_CASE("pbrt: one note for a PLY's normal (nx, ny, nz), not three") {
 
 TEST_CASE("pbrt: texture errors name every supported kind and type") {
   CHECK(contains(errorOf("WorldBegin\nTexture \"t\" \"bogus\" \"constant\"\n"), "(float, spectrum, or pbrt-v3's color/rgb)"));
-  CHECK(contains(errorOf("WorldBegin\nTexture \"t\" \"spectrum\" \"imagemap\"\n"),
-                 "type \"imagemap\" is not supported (supported: constant, and checkerboard as a reflectance)"));
+  CHECK(contains(errorOf("WorldBegin\nTexture \"t\" \"spectrum\" \"wrinkled\"\n"),
+                 "type \"wrinkled\" is not supported (supported: constant, scale, mix, checkerboard, imagemap)"));
 }
 
 TEST_CASE("pbrt: options errors are reported in file order (the first wrong statement, not the first mapped)") {

@@ -477,3 +477,26 @@ TEST_CASE("pbrt bilinear patch: a curved patch's surface positions follow the bi
       pbrt::importPbrtText("WorldBegin\nShape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\n", "dir/t.pbrt").scene;
   CHECK(flat.objects[0].shape.indices.size() == 6u);
 }
+
+TEST_CASE("disk and cylinder (u, v) are pbrt's: u = phi / phi_max, v from the rim inward / from z_min up") {
+  auto d = test::emptyScene(4, 4);
+  d.materials.push_back(test::diffuse(Rgb(0.5f)));
+  d.objects.push_back(diskObject(2.0f, 0.5f, 0.0f, 180, 0));          // upper half annulus, z = 0
+  scene::ObjectDesc cyl = cylinderObject(1.0f, 1.0f, 3.0f, 360, 0);  // r 1, z in [1, 3]
+  cyl.placement.translate = {10, 0, 0};
+  d.objects.push_back(cyl);
+  auto s = Scene::build(d);
+  Hit h;
+  // Disk at (x, y) = (0, 1.25): phi = 90 deg of 180 -> u 0.5; r = 1.25 -> v = (2 - 1.25) / 1.5 = 0.5.
+  REQUIRE(s->intersect({0, 1.25f, 5}, {0, 0, -1}, 1e30f, 0.5f, h));
+  REQUIRE(h.object == 0);
+  Vec2f uv = s->uvAt(h);
+  CHECK(uv.x == doctest::Approx(0.5f).epsilon(1e-5));
+  CHECK(uv.y == doctest::Approx(0.5f).epsilon(1e-5));
+  // Cylinder hit from -y at z = 2.5: phi = 270 deg -> u 0.75; v = (2.5 - 1) / 2 = 0.75.
+  REQUIRE(s->intersect({10, -5, 2.5f}, {0, 1, 0}, 1e30f, 0.5f, h));
+  REQUIRE(h.object == 1);
+  uv = s->uvAt(h);
+  CHECK(uv.x == doctest::Approx(0.75f).epsilon(1e-5));
+  CHECK(uv.y == doctest::Approx(0.75f).epsilon(1e-5));
+}

@@ -35,19 +35,10 @@ std::string fmtNum(double v);
 // one is used, so scenes written for pbrt's rule load too.
 std::string resolvePath(const std::string& name, const std::string& namingFile, const std::string& mainDir);
 
-// A 2D checkerboard in (u, v): parity of floor(uscale u + udelta) +
-// floor(vscale v + vdelta) picks tex1 (even) or tex2 (odd).
-struct Checker2D {
-  Rgb tex1{1, 1, 1}, tex2{0, 0, 0};
-  double su = 1, sv = 1, du = 0, dv = 0;
-  std::string name;
-};
-
 struct MaterialSlot {
   bool interface = false;  // "" / "interface" / "none": no surface at all
   scene::MaterialDesc desc;
   int index = -1;  // in scene.materials once a shape uses it
-  std::optional<Checker2D> checker;  // albedo: laid out per shape (pbrt_mapping.cpp, placeChecker)
   int mixSlots[2] = {-1, -1};  // mix: its two materials' slots
 };
 
@@ -82,10 +73,13 @@ struct StackEntry {
   Loc at;
 };
 
+// A Texture statement: its node in result.scene.textures, and its value
+// when it is a constant (which any parameter may then use).
 struct TextureValue {
   bool isFloat = false;
+  bool constant = true;
   Rgb value{1, 1, 1};
-  std::optional<Checker2D> checker;
+  int32_t index = -1;
 };
 
 struct Statement {  // an options-block statement kept until WorldBegin
@@ -139,7 +133,13 @@ class Importer {
     scene::MotionDesc keys;
   };
   MotionPlan planMotion(const Mat ctm[2], const Loc& at, const std::string& what) const;
-  std::optional<Checker2D> albedoChecker(const ParamSet& ps, const std::string& name) const;
+  // A texture statement's input parameter `name` (a texture, or a value).
+  scene::TexInput texInput(const ParamSet& ps, const std::string& name, bool isFloat, Rgb fallback,
+                           const std::string& what) const;
+  void imageTexture(scene::TextureDef& t, const ParamSet& ps, const Loc& at, const std::string& what);
+  // A reflectance that may be any spectrum texture: sets *index (a texture
+  // that varies; the value returned is then a placeholder) or returns the value.
+  Rgb textureParam(const ParamSet& ps, const std::string& name, Rgb fallback, int32_t* index) const;
   uint32_t materialIndex(int slot);
   std::string uniqueMaterialName(const std::string& base);
   Rgb color(const ParamSet& ps, const std::string& name, Rgb fallback) const;
@@ -168,6 +168,8 @@ class Importer {
   std::vector<MaterialSlot> materials_ = {defaultMaterial()};
   std::map<std::string, int> namedMaterials_;
   std::map<std::string, TextureValue> textures_;
+  // Image texels by (path, encoding): each file is read once.
+  std::map<std::pair<std::string, std::string>, std::shared_ptr<const image::ImageRgb>> textureImages_;
   std::map<std::string, Mat> coordSystems_;
   std::map<std::string, std::vector<ShapeRecord>> instances_;
   std::vector<ShapeRecord>* currentInstance_ = nullptr;

@@ -4,10 +4,12 @@
 // approximations leave a note. The statement half is pbrt_import.cpp.
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <functional>
 
 #include "core/error.h"
 #include "import/pbrt_importer.h"
+#include "image/texture_image.h"
 #include "import/ply_reader.h"
 #include "scene/bsdf_pbrt.h"
 #include "scene/environment.h"
@@ -40,7 +42,9 @@ Rgb Importer::color(const ParamSet& ps, const std::string& name, Rgb fallback) c
     if (p->strings.size() != 1) ps.fail(*p, "expected one texture name");
     auto it = textures_.find(p->strings[0]);
     if (it == textures_.end()) ps.fail(*p, "no texture named \"" + p->strings[0] + "\" has been defined");
-    if (it->second.checker) ps.fail(*p, "a checkerboard is supported only as the reflectance of diffuse or plastic materials");
+    if (!it->second.constant)
+      ps.fail(*p, "a texture that varies is supported only as a reflectance (Kd of matte and plastic, reflectance of "
+                  "diffuse, coateddiffuse and conductor, Kr of mirror, Kr = Kt of glass); here only a constant texture is");
     return it->second.value;
   }
   if (p->type == "spectrum" || p->type == "blackbody") return spectrumColor(ps, *p);
@@ -54,56 +58,151 @@ double Importer::floatParam(const ParamSet& ps, const std::string& name, double 
     p->used = true;
     auto it = p->strings.size() == 1 ? textures_.find(p->strings[0]) : textures_.end();
     if (it == textures_.end() || !it->second.isFloat) ps.fail(*p, "expected a float texture");
+    if (!it->second.constant) ps.fail(*p, "a float texture that varies is not supported here (only a constant one)");
     return it->second.value.r;
   }
   if (p->type == "spectrum") return spectrumFloat(ps, *p);  // v4: a spectral eta (a constant, a named glass, ...)
   return ps.getFloat(name, fallback);
 }
 
+scene::TexInput Importer::texInput(const ParamSet& ps, const std::string& name, bool isFloat, Rgb fallback,
+                                   const std::string& what) const {
+  scene::TexInput in;
+  in.value = fallback;
+  const Param* p = ps.find(name);
+  if (!p) return in;
+  if (p->type == "texture") {
+    p->used = true;
+    if (p->strings.size() != 1) ps.fail(*p, "expected one texture name");
+    auto it = textures_.find(p->strings[0]);
+    if (it == textures_.end()) ps.fail(*p, "no texture named \"" + p->strings[0] + "\" has been defined");
+    if (it->second.isFloat != isFloat)
+      ps.fail(*p, "texture \"" + p->strings[0] + "\" is a " + (it->second.isFloat ? "float" : "spectrum") + " texture, but " +
+                      what + " needs a " + (isFloat ? "float" : "spectrum") + " one");
+    in.texture = it->second.index;
+    return in;
+  }
+  in.value = isFloat ? Rgb(float(floatParam(ps, name, fallback.r))) : color(ps, name, fallback);
+  return in;
+}
+
+// pbrt's imagemap: the file, its encoding, wrap, filter, scale and invert.
+void Importer::imageTexture(scene::TextureDef& t, const ParamSet& ps, const Loc& at, const std::string& what) {
+  t.kind = scene::TextureDef::Kind::Image;
+  std::string file = ps.getString("filename", "");
+  if (file.empty()) failAt(at, what + ": missing parameter \"string filename\"");
+  t.file = resolvePath(file, at.file, mainDir);
+  if (ps.has("encoding")) {  // pbrt-v4
+    std::string e = ps.getString("encoding", "sRGB");
+    if (e == "sRGB") t.encoding.kind = image::TexelEncoding::Kind::Srgb;
+    else if (e == "linear") t.encoding.kind = image::TexelEncoding::Kind::Linear;
+    else if (e.compare(0, 6, "gamma ") == 0 && std::strtod(e.c_str() + 6, nullptr) > 0)
+      t.encoding = {image::TexelEncoding::Kind::Gamma, float(std::strtod(e.c_str() + 6, nullptr))};
+    else failAt(at, what + ": unknown encoding \"" + e + "\" (sRGB, linear or \"gamma <g>\")");
+  } else if (ps.has("gamma")) {  // pbrt-v3: true is sRGB
+    t.encoding.kind = ps.getBool("gamma", true) ? image::TexelEncoding::Kind::Srgb : image::TexelEncoding::Kind::Linear;
+  }
+  std::string wrap = ps.getString("wrap", "repeat");
+  if (wrap == "repeat") t.wrap = scene::TextureDef::Wrap::Repeat;
+  else if (wrap == "clamp") t.wrap = scene::TextureDef::Wrap::Clamp;
+  else if (wrap == "black") t.wrap = scene::TextureDef::Wrap::Black;
+  else failAt(at, what + ": unknown wrap mode \"" + wrap + "\" (supported: repeat, clamp, black)");
+  std::string filter = ps.getString("filter", "bilinear");
+  if (filter == "point") t.filter = scene::TextureDef::Filter::Point;
+  else if (filter != "bilinear" && filter != "trilinear" && filter != "ewa")
+    failAt(at, what + ": unknown filter \"" + filter + "\" (point, bilinear, trilinear, ewa)");
+  if (filter == "trilinear" || filter == "ewa" || ps.has("trilinear") || (pbrtV3() && !ps.has("filter")))
+    note(at, what + ": MIP-map filtering (trilinear / EWA) approximated by bilinear lookups (tdpm supersamples instead)");
+  for (const char* q : {"maxanisotropy", "trilinear"}) ps.markUsed(q);
+  t.scale = float(ps.getFloat("scale", 1));
+  if (!(t.scale >= 0)) failAt(at, what + ": scale must not be negative");
+  t.invert = ps.getBool("invert", false);
+  auto key = std::make_pair(t.file, image::encodingName(t.encoding));
+  auto& img = textureImages_[key];
+  if (!img) {
+    try {
+      img = std::make_shared<const image::ImageRgb>(image::readTextureImage(t.file, t.encoding));
+    } catch (const Error& e) {
+      textureImages_.erase(key);
+      failAt(at, what + ": " + e.what());
+    }
+    result.inputFiles.push_back(t.file);
+  }
+  t.image = img;
+}
+
 void Importer::texture(const std::string& name, const std::string& kind, const std::string& type, const ParamSet& ps,
                        const Loc& at) {
   bool isFloat = kind == "float";
+  const std::string what = "Texture \"" + name + "\"";
   if (!isFloat && kind != "spectrum" && kind != "color" && kind != "rgb")
-    failAt(at, "Texture \"" + name + "\": unknown texture kind \"" + kind + "\" (float, spectrum, or pbrt-v3's color/rgb)");
-  TextureValue t;
+    failAt(at, what + ": unknown texture kind \"" + kind + "\" (float, spectrum, or pbrt-v3's color/rgb)");
+  scene::TextureDef t;
+  t.name = name;
   t.isFloat = isFloat;
+  TextureValue v;
+  v.isFloat = isFloat;
+  v.constant = type == "constant";
+  auto mapping = [&]() {
+    std::string m = ps.getString("mapping", "uv");
+    if (m != "uv") failAt(at, what + ": only the \"uv\" mapping is supported, not \"" + m + "\"");
+    t.uscale = float(ps.getFloat("uscale", 1));
+    t.vscale = float(ps.getFloat("vscale", 1));
+    t.udelta = float(ps.getFloat("udelta", 0));
+    t.vdelta = float(ps.getFloat("vdelta", 0));
+  };
   if (type == "constant") {
-    t.value = isFloat ? Rgb(float(floatParam(ps, "value", 1.0))) : color(ps, "value", Rgb(1.0f));
+    t.kind = scene::TextureDef::Kind::Constant;
+    v.value = isFloat ? Rgb(float(floatParam(ps, "value", 1.0))) : color(ps, "value", Rgb(1.0f));
+    t.a.value = v.value;
+  } else if (type == "scale") {
+    t.kind = scene::TextureDef::Kind::Scale;
+    if (ps.has("tex1") || ps.has("tex2")) {  // pbrt-v3: tex1 x tex2
+      t.a = texInput(ps, "tex1", isFloat, Rgb(1.0f), what);
+      t.b = texInput(ps, "tex2", isFloat, Rgb(1.0f), what);
+    } else {
+      t.a = texInput(ps, "tex", isFloat, Rgb(1.0f), what);
+      t.b = texInput(ps, "scale", true, Rgb(1.0f), what + "'s scale");
+    }
+  } else if (type == "mix") {
+    t.kind = scene::TextureDef::Kind::Mix;
+    t.a = texInput(ps, "tex1", isFloat, Rgb(0.0f), what);
+    t.b = texInput(ps, "tex2", isFloat, Rgb(1.0f), what);
+    t.amount = texInput(ps, "amount", true, Rgb(0.5f), what + "'s amount");
   } else if (type == "checkerboard") {
-    if (isFloat) failAt(at, "Texture \"" + name + "\": a float checkerboard is not supported (only as a reflectance)");
-    if (ps.getInt("dimension", 2) != 2) failAt(at, "Texture \"" + name + "\": a 3D checkerboard is not supported (dimension 2 only)");
-    if (ps.getString("mapping", "uv") != "uv") failAt(at, "Texture \"" + name + "\": only the \"uv\" mapping is supported");
-    Checker2D c;
-    c.name = name;
-    c.tex1 = color(ps, "tex1", Rgb(1.0f));
-    c.tex2 = color(ps, "tex2", Rgb(0.0f));
-    c.su = ps.getFloat("uscale", 1);
-    c.sv = ps.getFloat("vscale", 1);
-    c.du = ps.getFloat("udelta", 0);
-    c.dv = ps.getFloat("vdelta", 0);
-    if (!(c.su > 0) || !(c.sv > 0)) failAt(at, "Texture \"" + name + "\": uscale and vscale must be positive");
+    if (ps.getInt("dimension", 2) != 2)
+      failAt(at, what + ": a 3D checkerboard is not supported (dimension 2 only: pbrt's 3D one lives in the texture's own space)");
+    t.kind = scene::TextureDef::Kind::Checkerboard;
+    mapping();
+    t.a = texInput(ps, "tex1", isFloat, Rgb(1.0f), what);
+    t.b = texInput(ps, "tex2", isFloat, Rgb(0.0f), what);
     for (const char* q : {"aamode", "filter"})
       if (ps.has(q)) ps.markUsed(q);
-    note(at, "Texture \"" + name + "\": the checkerboard's antialiasing filter is not applied (tdpm supersamples instead)");
-    t.checker = c;
+    note(at, what + ": the checkerboard's antialiasing filter is not applied (tdpm supersamples instead)");
+  } else if (type == "imagemap") {
+    mapping();
+    imageTexture(t, ps, at, what);
   } else {
-    failAt(at, "Texture \"" + name + "\": type \"" + type + "\" is not supported (supported: constant, and checkerboard as a reflectance)");
+    failAt(at, what + ": type \"" + type + "\" is not supported (supported: constant, scale, mix, checkerboard, imagemap)");
   }
   ps.checkAllUsed();
-  textures_[name] = t;
+  result.scene.textures.push_back(std::move(t));
+  v.index = int32_t(result.scene.textures.size() - 1);
+  textures_[name] = v;
 }
 
-std::optional<Checker2D> Importer::albedoChecker(const ParamSet& ps, const std::string& name) const {
+Rgb Importer::textureParam(const ParamSet& ps, const std::string& name, Rgb fallback, int32_t* index) const {
   const Param* p = ps.find(name);
-  if (!p || p->type != "texture" || p->strings.size() != 1) return std::nullopt;
-  auto it = textures_.find(p->strings[0]);
-  if (it == textures_.end() || !it->second.checker) return std::nullopt;
-  p->used = true;
-  const Checker2D& c = *it->second.checker;
-  for (Rgb v : {c.tex1, c.tex2})
-    if (v.r < 0 || v.g < 0 || v.b < 0 || v.maxComponent() > 1)
-      ps.fail(*p, "the checkerboard's colours must be reflectances in [0, 1] per channel");
-  return c;
+  if (p && p->type == "texture" && p->strings.size() == 1) {
+    auto it = textures_.find(p->strings[0]);
+    if (it != textures_.end() && !it->second.constant) {
+      p->used = true;
+      if (it->second.isFloat) ps.fail(*p, "texture \"" + p->strings[0] + "\" is a float texture, but a reflectance needs a spectrum one");
+      *index = it->second.index;
+      return Rgb(0.5f);  // not used: the texture is (clamped to [0, 1] when evaluated)
+    }
+  }
+  return color(ps, name, fallback);
 }
 
 static void checkReflectance(const ParamSet& ps, const std::string& name, Rgb c) {
@@ -158,13 +257,12 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
   } else if (type == "matte" || type == "diffuse") {
     m.type = T::Diffuse;
     std::string key = type == "matte" ? "Kd" : "reflectance";
-    slot.checker = albedoChecker(ps, key);
-    m.albedo.color = slot.checker ? slot.checker->tex1 : color(ps, key, Rgb(0.5f));
+    m.albedo.color = textureParam(ps, key, Rgb(0.5f), &m.albedoTexture);
     checkReflectance(ps, key, m.albedo.color);
     if (type == "matte" && floatParam(ps, "sigma", 0) != 0) failAt(at, label + ": Oren-Nayar roughness (sigma > 0) is not supported");
   } else if (type == "mirror") {
     m.type = T::Mirror;
-    m.specular = color(ps, "Kr", Rgb(0.9f));
+    m.specular = textureParam(ps, "Kr", Rgb(0.9f), &m.specularTexture);
     checkReflectance(ps, "Kr", m.specular);
   } else if (type == "glass" || type == "dielectric") {
     double eta = floatParam(ps, "eta", ps.has("index") ? floatParam(ps, "index", 1.5) : 1.5);
@@ -176,8 +274,10 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     m.type = alpha < kSmoothAlpha ? T::Dielectric : T::RoughDielectric;
     m.roughness = float(alpha);
     if (type == "glass") {
-      Rgb kr = color(ps, "Kr", Rgb(1.0f)), kt = color(ps, "Kt", Rgb(1.0f));
-      if (kr.r != kt.r || kr.g != kt.g || kr.b != kt.b)
+      int32_t tr = -1, tt = -1;
+      Rgb kr = textureParam(ps, "Kr", Rgb(1.0f), &tr), kt = textureParam(ps, "Kt", Rgb(1.0f), &tt);
+      m.specularTexture = tr;
+      if (tr != tt || kr.r != kt.r || kr.g != kt.g || kr.b != kt.b)
         failAt(at, label + ": Kr and Kt differ; tdpm's dielectric has one tint for reflection and transmission");
       checkReflectance(ps, "Kr", kr);
       m.specular = kr;
@@ -194,9 +294,8 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     // dielectric Fresnel at eta 1.5); translucent keeps its reflection lobes.
     bool substrate = type == "substrate";
     m.type = substrate ? T::Substrate : T::Uber;
-    slot.checker = albedoChecker(ps, "Kd");
     Rgb kdDefault(type == "plastic" || type == "uber" || type == "translucent" ? 0.25f : 0.5f);
-    m.albedo.color = slot.checker ? slot.checker->tex1 : color(ps, "Kd", kdDefault);
+    m.albedo.color = textureParam(ps, "Kd", kdDefault, &m.albedoTexture);
     checkReflectance(ps, "Kd", m.albedo.color);
     m.specular = color(ps, "Ks", Rgb(substrate ? 0.5f : 0.25f));
     checkReflectance(ps, "Ks", m.specular);
@@ -211,7 +310,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
       Rgb kr = color(ps, "Kr", Rgb(0.0f)), kt = color(ps, "Kt", Rgb(0.0f)), op = color(ps, "opacity", Rgb(1.0f));
       if (op.r != 1 || op.g != 1 || op.b != 1) failAt(at, label + ": uber's opacity below 1 is not supported");
       if (!kr.isBlack() || !kt.isBlack()) {
-        if (!m.albedo.color.isBlack() || !m.specular.isBlack() || slot.checker)
+        if (!m.albedo.color.isBlack() || !m.specular.isBlack() || m.albedoTexture >= 0)
           failAt(at, label + ": uber with specular lobes (Kr, Kt) beside Kd or Ks is not supported "
                              "(tdpm's materials are delta-only or not at all)");
         if (kr.r != kt.r || kr.g != kt.g || kr.b != kt.b)
@@ -225,7 +324,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
       (void)t;
       m.albedo.color = m.albedo.color * r;
       m.specular = m.specular * r;
-      if (slot.checker) failAt(at, label + ": a checkerboard Kd on translucent is not supported");
+      if (m.albedoTexture >= 0) failAt(at, label + ": a textured Kd on translucent is not supported");
       note(at, label + ": translucent approximated by its reflection lobes alone (Lambert reflect x Kd and GGX "
                        "reflect x Ks, as uber); its transmission is dropped (see docs/pbrt-import.md)");
     }
@@ -240,8 +339,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     m.roughness = float(std::max(alpha, 1e-3));
     if (diffuse) {
       m.type = T::CoatedDiffuse;
-      slot.checker = albedoChecker(ps, "reflectance");
-      m.albedo.color = slot.checker ? slot.checker->tex1 : color(ps, "reflectance", Rgb(0.5f));
+      m.albedo.color = textureParam(ps, "reflectance", Rgb(0.5f), &m.albedoTexture);
       checkReflectance(ps, "reflectance", m.albedo.color);
     } else {
       m.type = T::CoatedConductor;
@@ -268,7 +366,6 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
         ps.fail(*p, "no material named \"" + p->strings[size_t(i)] + "\" has been made");
       const MaterialSlot& c = materials_[size_t(it->second)];
       if (c.interface) ps.fail(*p, "material \"" + p->strings[size_t(i)] + "\" is an interface; a mix needs surfaces");
-      if (c.checker) ps.fail(*p, "material \"" + p->strings[size_t(i)] + "\" has a checkerboard, which a mix does not support");
       slot.mixSlots[i] = it->second;
     }
     m.type = T::Mix;
@@ -685,6 +782,7 @@ static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(co
            " ignored (tdpm shades with the geometric normal)");
     }
     g.vertices = std::move(ply.vertices);
+    g.uv = std::move(ply.uvs);
     g.indices = std::move(ply.triangles);
     addQuads(g.vertices, ply.quads, rec.at, "Shape \"plymesh\" \"" + file + "\"", &g.indices);
   } else if (rec.type == "loopsubdiv") {
@@ -765,60 +863,6 @@ static bool nearlyUniform(Vec3f s) {
   return std::fabs(std::fabs(s.y) - a) <= 1e-5f * a && std::fabs(std::fabs(s.z) - a) <= 1e-5f * a;
 }
 
-// tdpm's checker is 3D in object space: parity of floor(x/s + 1/2) +
-// floor(y/s + 1/2) + floor(z/s + 1/2). On a flat mesh whose (u, v) are an
-// affine, orthogonal parametrisation with square cells it equals pbrt's 2D
-// checkerboard exactly, if the mesh is expressed in a local frame with x
-// along dp/du, z along dp/dv, y = 0 on the surface and
-//   x = s (uscale u + udelta - 1/2),  z = s (vscale v + vdelta - 1/2).
-// Returns the local vertices, the placement and the cell size s.
-struct CheckerFrame {
-  std::vector<Vec3f> local;
-  scene::TransformDesc placement;
-  float cell = 1;
-};
-
-static CheckerFrame placeChecker(const std::vector<Vec3f>& world, const std::vector<Vec2f>& uv,
-                                 const std::vector<uint32_t>& idx, const Checker2D& c, const Loc& at) {
-  const std::string what = "Shape with checkerboard \"" + c.name + "\"";
-  // dp/du, dp/dv from the first triangle with a non-degenerate (u, v).
-  Vec3f dpdu, dpdv;
-  bool found = false;
-  for (size_t t = 0; t + 2 < idx.size() && !found; t += 3) {
-    Vec2f a = uv[idx[t]], b = uv[idx[t + 1]], d = uv[idx[t + 2]];
-    double du1 = b.x - a.x, dv1 = b.y - a.y, du2 = d.x - a.x, dv2 = d.y - a.y;
-    double det = du1 * dv2 - du2 * dv1;
-    if (std::fabs(det) < 1e-12) continue;
-    Vec3f e1 = world[idx[t + 1]] - world[idx[t]], e2 = world[idx[t + 2]] - world[idx[t]];
-    dpdu = (e1 * float(dv2) - e2 * float(dv1)) / float(det);
-    dpdv = (e2 * float(du1) - e1 * float(du2)) / float(det);
-    found = true;
-  }
-  if (!found) failAt(at, what + ": its (u, v) coordinates are degenerate");
-  float lu = length(dpdu), lv = length(dpdv);
-  if (!(lu > 0) || !(lv > 0) || std::fabs(dot(dpdu, dpdv)) > 1e-4f * lu * lv)
-    failAt(at, what + ": (u, v) must run along perpendicular directions for tdpm's checker");
-  float cell = float(lu / c.su);
-  if (std::fabs(float(lv / c.sv) - cell) > 1e-4f * cell)
-    failAt(at, what + ": the cells are not square (tdpm's checker has one cell size)");
-  Vec3f ex = dpdu / lu, ez = dpdv / lv, ey = cross(ez, ex);
-  double R[3][3] = {{ex.x, ey.x, ez.x}, {ex.y, ey.y, ez.y}, {ex.z, ey.z, ez.z}};
-  CheckerFrame f;
-  f.cell = cell;
-  f.placement.rotate = canonicalRotation(quaternionFromMatrix(R));
-  Affine3f rot = Affine3f::rotate(f.placement.rotate);
-  for (size_t i = 0; i < world.size(); ++i)
-    f.local.push_back({float(cell * (c.su * uv[i].x + c.du - 0.5)), 0.0f, float(cell * (c.sv * uv[i].y + c.dv - 0.5))});
-  f.placement.translate = world[idx[0]] - rot.point(f.local[idx[0]]);
-  // Every vertex must be where the affine (u, v) map puts it: a flat mesh.
-  float size = 0;
-  for (Vec3f w : world) size = std::max(size, length(w - world[idx[0]]));
-  for (size_t i = 0; i < world.size(); ++i)
-    if (length(rot.point(f.local[i]) + f.placement.translate - world[i]) > 1e-4f * std::max(size, 1e-30f))
-      failAt(at, what + ": the mesh is not flat with an affine (u, v), which tdpm's checker needs");
-  return f;
-}
-
 void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& instanceAt) {
   if (rec.area && rec.type == "disk") return emitRoundLight(rec, ctm);  // an emitter only: no Geometry
   Geometry g = makeGeometry(rec, [&](const std::string& w) { note(rec.at, w); }, mainDir, result.inputFiles);
@@ -842,7 +886,6 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
   o.name = "Shape \"" + rec.type + "\" (" + rec.at.str() + (instanceAt.file.empty() ? "" : ", instance at " + instanceAt.str()) + ")";
   MotionPlan plan = planMotion(ctm, rec.at, "Shape \"" + rec.type + "\"");
   if (g.sphere) {
-    if (mat.checker) failAt(rec.at, "Shape \"sphere\": a checkerboard on a sphere is not supported (tdpm's checker is not in (u, v))");
     o.shape.type = scene::ShapeDesc::Type::Sphere;
     o.shape.radius = g.radius;
     if (!plan.moving) {
@@ -865,7 +908,6 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
     // (tdpm's own x mirror is not in ctm: a mirror keeps sides.)
     o.shape.reverseOrientation = rec.reverseOrientation != (ctm[0].det3() < 0);
   } else if (g.quadric) {
-    if (mat.checker) failAt(rec.at, "Shape \"" + rec.type + "\": a checkerboard on a disk or cylinder is not supported (tdpm's checker is not in (u, v))");
     o.shape = *g.quadric;
     if (!plan.moving) {
       std::string degenerate = scaleProblem(plan.still);
@@ -886,28 +928,6 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
     o.shape.reverseOrientation = rec.reverseOrientation;
     o.shape.indices = g.indices;
     o.shape.loopLevels = g.loopLevels;  // placements are affine: refining after baking them is exact
-    if (mat.checker) {
-      if (plan.moving) failAt(rec.at, "a moving shape with a checkerboard is not supported");
-      if (g.uv.empty()) failAt(rec.at, "a checkerboard needs per-vertex \"uv\" (or a single bilinear patch)");
-      std::vector<Vec3f> world;
-      for (Vec3f v : g.vertices) world.push_back(plan.still.point(v));
-      CheckerFrame f = placeChecker(world, g.uv, g.indices, *mat.checker, rec.at);
-      o.shape.vertices = f.local;  // a rigid map of the baked vertices: the winding keeps its orientation
-      o.placement = f.placement;
-      if (plan.still.det3() < 0)
-        for (size_t i = 0; i < o.shape.indices.size(); i += 3) std::swap(o.shape.indices[i + 1], o.shape.indices[i + 2]);
-      scene::MaterialDesc m = mat.desc;  // the cell size depends on the shape: one material per shape
-      m.albedo.kind = scene::TextureDesc::Kind::Checker;
-      m.albedo.color = mat.checker->tex1;
-      m.albedo.color2 = mat.checker->tex2;
-      m.albedo.scale = f.cell;
-      m.name = uniqueMaterialName((mat.desc.name.empty() ? "material" : mat.desc.name) + " (checkerboard " + rec.at.str() + ")");
-      result.scene.materials.push_back(m);
-      o.material = uint32_t(result.scene.materials.size() - 1);
-      result.scene.objects.push_back(std::move(o));
-      objectAt_.push_back(rec.at);
-      return;
-    }
     if (!plan.moving) {
       // Bake the placement into the vertices (any affine map is exact). A
       // mirroring map flips the winding; swap it back so the face normal
@@ -922,6 +942,10 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
     for (Vec3f v : o.shape.vertices)
       if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
         failAt(rec.at, "Shape \"" + rec.type + "\": a vertex is not finite after its transform");
+    // (u, v) per corner, after any winding swap (per-vertex values follow
+    // their vertex); loopsubdiv has none (its triangles are new).
+    if (g.uv.size() == g.vertices.size() && g.loopLevels < 0)
+      for (uint32_t i : o.shape.indices) o.shape.uvs.push_back(g.uv[i]);
   }
   o.material = materialIndex(rec.material);
   result.scene.objects.push_back(std::move(o));

@@ -452,7 +452,8 @@ struct Tracer {
         }
         if (settings.kind == MapKind::Caustic && !glossyBounce) return rays;  // L (S|G)+ D ends here
       }
-      ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
+      std::optional<Material> textured;
+      ShadingContext ctx = makeShadingContext(scene.shadedMaterial(mat, hit, textured), scene.albedoAt(mat, hit), hit.n, -dir);
       BsdfSample bs;
       Vec3f ub = rng.get3D(dims::vertexGroup(bounce, dims::kBsdf));
       if (!bsdfSample(ctx, {ub.x, ub.y}, ub.z, Transport::Importance, bs)) return rays;

@@ -72,7 +72,8 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
     }
     if (depth == lastDepth) break;
     const Material& mat = resolveMaterial(scene_.materials.data(), scene_.objects[hit.object].material, hit.p, -dir);
-    ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
+    std::optional<Material> textured;
+    ShadingContext ctx = makeShadingContext(scene_.shadedMaterial(mat, hit, textured), scene_.albedoAt(mat, hit), hit.n, -dir);
 
     // Guide cones at the first two diffuse vertices: not only a caustic
     // seen directly (or in a mirror), but also one lighting what is seen,

@@ -134,7 +134,8 @@ Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, flo
         break;
       }
       const Material& m = resolveMaterial(scene_.materials.data(), scene_.objects[h.object].material, h.p, -d);
-      ShadingContext c = makeShadingContext(m, m.albedo.at(h.localP), h.n, -d);
+      std::optional<Material> textured;
+      ShadingContext c = makeShadingContext(scene_.shadedMaterial(m, h, textured), scene_.albedoAt(m, h), h.n, -d);
       // Through mirrors, glass and sharp metals to the first diffuse-like
       // surface: light a sharp metal reflects toward the gather point is in
       // the caustic map (L (S|G)+ D, Material::isGlossy), and light reaching
@@ -243,7 +244,8 @@ Rgb PhotonIntegrator::traceFrom(Vec3f origin, Vec3f dir, float time01, EyeVertex
       break;
     }
     const Material& mat = resolveMaterial(scene_.materials.data(), scene_.objects[hit.object].material, hit.p, -dir);
-    ShadingContext ctx = makeShadingContext(mat, mat.albedo.at(hit.localP), hit.n, -dir);
+    std::optional<Material> textured;
+    ShadingContext ctx = makeShadingContext(scene_.shadedMaterial(mat, hit, textured), scene_.albedoAt(mat, hit), hit.n, -dir);
     bool timeDependent = s_.timeDependent && touched;
     float minVolume = s_.footprintVolume * pathLength * pathLength;
 

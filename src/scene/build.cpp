@@ -4,6 +4,7 @@
 // constants, swept bounds and the scene's scale.
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 #include "core/error.h"
 #include "scene/bsdf_pbrt.h"
@@ -20,12 +21,17 @@ using scene::ShapeDesc;
 struct TriangleMesh {
   std::vector<Vec3f> vertices;
   std::vector<uint32_t> indices;
+  std::vector<Vec2f> uvs;  // per corner, or empty
 };
 
 // Quad in the local x-z plane, normal +y (counter-clockwise seen from +y).
 TriangleMesh makeQuad(float sx, float sz) {
   float x = 0.5f * sx, z = 0.5f * sz;
-  return {{{-x, 0, -z}, {-x, 0, z}, {x, 0, z}, {x, 0, -z}}, {0, 1, 2, 0, 2, 3}};
+  // (u, v): u along +x, v along -z, so an image lies upright seen from +y
+  // with -z up (its top row at z = -sz / 2).
+  return {{{-x, 0, -z}, {-x, 0, z}, {x, 0, z}, {x, 0, -z}},
+          {0, 1, 2, 0, 2, 3},
+          {{0, 1}, {0, 0}, {1, 0}, {0, 1}, {1, 0}, {1, 1}}};
 }
 
 // Axis-aligned box centred at the origin, outward-facing triangles.
@@ -103,6 +109,8 @@ Material toMaterial(const scene::MaterialDesc& d) {
   m.albedo.a = d.albedo.color;
   m.albedo.b = d.albedo.color2;
   m.albedo.invScale = 1.0f / d.albedo.scale;
+  m.albedoTexture = d.albedoTexture;
+  m.specularTexture = d.specularTexture;  // node i of the TextureSet is desc.textures[i]
   m.specular = d.specular;
   m.ior = d.ior;
   // Keep GGX away from alpha -> 0, where D is a numerically unstable spike.
@@ -199,6 +207,49 @@ void prepareEmitter(Light& l, const scene::LightDesc& d) {
   l.mesh = std::move(mesh);
 }
 
+TexNodeInput toInput(const scene::TexInput& in) { return {in.texture, in.value}; }
+
+// desc.textures -> flat nodes (same indices) and each image's texels once.
+TextureSet toTextures(const std::vector<scene::TextureDef>& defs) {
+  using K = scene::TextureDef::Kind;
+  TextureSet set;
+  std::map<const image::ImageRgb*, uint32_t> imageIndex;
+  for (const scene::TextureDef& d : defs) {
+    TextureNode n;
+    switch (d.kind) {
+      case K::Constant: n.kind = TextureNode::Kind::Constant; break;
+      case K::Image: n.kind = TextureNode::Kind::Image; break;
+      case K::Scale: n.kind = TextureNode::Kind::Scale; break;
+      case K::Mix: n.kind = TextureNode::Kind::Mix; break;
+      case K::Checkerboard: n.kind = TextureNode::Kind::Checkerboard; break;
+      case K::Checker3D: n.kind = TextureNode::Kind::Checker3D; break;
+    }
+    n.a = toInput(d.a);
+    n.b = toInput(d.b);
+    n.amount = toInput(d.amount);
+    n.uscale = d.uscale, n.vscale = d.vscale, n.udelta = d.udelta, n.vdelta = d.vdelta;
+    n.invCell = 1.0f / d.cell;
+    if (d.kind == K::Image) {
+      TDPM_ASSERT(d.image && !d.image->empty(), "image texture without texels");
+      auto [it, added] = imageIndex.try_emplace(d.image.get(), uint32_t(set.images.size()));
+      if (added) {
+        set.images.push_back({d.image->width, d.image->height, set.texels.size()});
+        set.texels.insert(set.texels.end(), d.image->pixels.begin(), d.image->pixels.end());
+      }
+      n.image = it->second;
+      n.wrap = d.wrap == scene::TextureDef::Wrap::Repeat  ? TextureNode::Wrap::Repeat
+               : d.wrap == scene::TextureDef::Wrap::Clamp ? TextureNode::Wrap::Clamp
+                                                          : TextureNode::Wrap::Black;
+      n.bilinear = d.filter == scene::TextureDef::Filter::Bilinear;
+      n.scale = d.scale;
+      n.invert = d.invert;
+      n.firstChannel = d.isFloat;
+    }
+    set.nodes.push_back(n);
+  }
+  return set;
+}
+
 Light toLight(const scene::LightDesc& d, const Shutter& shutter) {
   Light l;
   switch (d.type) {
@@ -288,6 +339,8 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
   for (size_t i = 0; i < s.materials.size(); ++i)
     if (s.materials[i].type == Material::Type::Mix) classifyMix(s.materials, desc.materials, i, mixState);
 
+  s.textures = toTextures(desc.textures);
+
   for (const auto& od : desc.objects) {
     SceneObject o;
     o.name = od.name;
@@ -326,11 +379,12 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
                                              scene::limits::kMaxSubdividedTriangles);
             mesh = {std::move(refined.vertices), std::move(refined.indices)};
           } else {
-            mesh = {od.shape.vertices, od.shape.indices};
+            mesh = {od.shape.vertices, od.shape.indices, od.shape.uvs};
           }
           break;
       }
       for (Vec3f v : mesh.vertices) o.objectBounds.extend(v);
+      if (mesh.uvs.size() == mesh.indices.size()) o.uvs = std::move(mesh.uvs);
       o.faceNormals.reserve(mesh.indices.size() / 3);
       for (size_t i = 0; i < mesh.indices.size(); i += 3) {
         Vec3f a = mesh.vertices[mesh.indices[i]], b = mesh.vertices[mesh.indices[i + 1]],

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "image/image.h"
+#include "image/texture_image.h"
 #include "math/transform.h"
 #include "math/vec.h"
 
@@ -45,6 +46,44 @@ struct TextureDesc {
   float scale = 1.0f;            // checker cell size in object space (m)
 };
 
+// A texture's input: another texture (an index into
+// SceneDescription::textures, always lower than the user's own) or, when
+// texture < 0, the constant value.
+struct TexInput {
+  int32_t texture = -1;
+  Rgb value{1, 1, 1};
+};
+
+// A named texture ("textures" in the JSON, pbrt's Texture statement).
+// Evaluated at a hit's (u, v) (scene/texture.h); every kind gives RGB, a
+// float texture R = G = B.
+struct TextureDef {
+  enum class Kind { Constant, Image, Scale, Mix, Checkerboard, Checker3D };
+  enum class Wrap { Repeat, Clamp, Black };
+  enum class Filter { Bilinear, Point };
+  std::string name;
+  Kind kind = Kind::Constant;
+  bool isFloat = false;  // a float texture: an image gives its first channel
+  // constant: a.value; scale: a x b; mix: (1 - amount) a + amount b (amount a
+  // float); checkerboard (2D in (s, t)) and checker3d (object space): a on
+  // even cells, b on odd ones.
+  TexInput a, b, amount;
+  // (s, t) = (uscale u + udelta, vscale v + vdelta): image, checkerboard.
+  float uscale = 1, vscale = 1, udelta = 0, vdelta = 0;
+  // image: the file (resolved against the scene's folder), its 8-bit
+  // encoding, lookups, and v = scale x texel, then 1 - v clamped at 0 when
+  // inverted (pbrt-v4's order). Texels are read by the parser / importer,
+  // once per (file, encoding) however many textures use them.
+  std::string file;
+  image::TexelEncoding encoding;
+  Wrap wrap = Wrap::Repeat;
+  Filter filter = Filter::Bilinear;
+  float scale = 1;
+  bool invert = false;
+  std::shared_ptr<const image::ImageRgb> image;
+  float cell = 1;  // checker3d: cell size (m), cells centred as the inline "checker"
+};
+
 struct MaterialDesc {
   // Conductor .. Mix: pbrt's materials (scene/material.h, docs/scene-format.md).
   enum class Type { Diffuse, Mirror, Dielectric, Metal, Plastic,
@@ -60,6 +99,12 @@ struct MaterialDesc {
   float thickness = 0.01f;     // coated: the layer's thickness (pbrt-v4's units: optical depth)
   uint32_t mix[2] = {0, 0};    // mix: indices into SceneDescription::materials
   float amount = 0.5f;         // mix: probability of mix[1], in [0, 1]
+  // Diffuse / plastic: a named texture (index into SceneDescription::
+  // textures, a spectrum one) that replaces albedo when >= 0.
+  int32_t albedoTexture = -1;
+  // Mirror, metal, dielectric (and pbrt's glass): a spectrum texture for
+  // `specular` when >= 0.
+  int32_t specularTexture = -1;
 };
 
 struct ShapeDesc {
@@ -87,6 +132,9 @@ struct ShapeDesc {
   // Mesh: Loop subdivision levels (scene/subdivision.h), -1 for none. The
   // vertices and indices above stay the control mesh; scene/build.cpp refines.
   int loopLevels = -1;
+  // Mesh: (u, v) per triangle corner (3 per triangle, as indices), or empty:
+  // each triangle gets pbrt's default (0,0), (1,0), (1,1).
+  std::vector<Vec2f> uvs;
 };
 
 struct ObjectDesc {
@@ -208,6 +256,7 @@ struct SceneDescription {
   std::string sourcePath;  // the JSON file, as given
   std::optional<AnimationDesc> animation;  // absent: one frame, camera.shutter
   CameraDesc camera;
+  std::vector<TextureDef> textures;  // inputs before the textures that use them
   std::vector<MaterialDesc> materials;
   std::vector<ObjectDesc> objects;
   std::vector<LightDesc> lights;

@@ -330,7 +330,7 @@ bool EmbreeScene::intersect(Vec3f o, Vec3f d, float tFar, float time01, RawHit& 
   const Impl::Layer* layers = impl_->layers;
   rtcIntersect1(layers[Impl::kStillMeshes].scene, &ctx, &rh);
   const Impl::Layer* found = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? &layers[Impl::kStillMeshes] : nullptr;
-  RawHit best{rh.ray.tfar, rh.hit.geomID, rh.hit.primID};
+  RawHit best{rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v};
   if (impl_->gated) {
     // Each later layer searches only in front of the hit so far (Embree
     // reports a hit only below tfar), and only if its bounds are there.
@@ -342,13 +342,15 @@ bool EmbreeScene::intersect(Vec3f o, Vec3f d, float tFar, float time01, RawHit& 
       rtcIntersect1(layer.scene, &ctx, &rh);
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
       found = &layer;
-      best = {rh.ray.tfar, rh.hit.geomID, rh.hit.primID};
+      best = {rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v};
     }
   }
   if (!found) return false;
   hit.t = best.t;
   hit.geometryId = found->ids[best.geometryId];
   hit.primitiveId = best.primitiveId;
+  hit.u = best.u;
+  hit.v = best.v;
   return true;
 }
 

@@ -22,6 +22,7 @@ namespace tdpm {
 struct RawHit {
   float t;
   uint32_t geometryId, primitiveId;
+  float u, v;  // triangles: barycentrics of vertices 1 and 2 (textures' uv)
 };
 
 class EmbreeScene {

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
@@ -75,18 +76,93 @@ Json texture(const scene::TextureDesc& t) {
   return Json{{"type", "checker"}, {"colors", Json::array({rgb(t.color), rgb(t.color2)})}, {"scale", num(t.scale)}};
 }
 
-Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDesc>& materials) {
+// A texture file's name as the JSON gives it: relative to the JSON's
+// folder when both paths allow it, else absolute.
+std::string relativeToJson(const std::string& file, const std::filesystem::path& jsonPath) {
+  std::filesystem::path f = std::filesystem::absolute(file).lexically_normal();
+  std::filesystem::path dir = std::filesystem::absolute(jsonPath).lexically_normal().parent_path();
+  std::filesystem::path rel = f.lexically_relative(dir);
+  return rel.empty() ? f.string() : rel.string();
+}
+
+// Every texture's name in the JSON: its own, made unique and non-empty.
+std::vector<std::string> textureNames(const std::vector<scene::TextureDef>& defs) {
+  std::vector<std::string> names;
+  std::set<std::string> used;
+  for (size_t i = 0; i < defs.size(); ++i) {
+    std::string base = defs[i].name.empty() ? "texture" + std::to_string(i) : defs[i].name, name = base;
+    for (int k = 2; used.count(name); ++k) name = base + "#" + std::to_string(k);
+    used.insert(name);
+    names.push_back(name);
+  }
+  return names;
+}
+
+Json texInput(const scene::TexInput& in, bool isFloat, const std::vector<std::string>& names) {
+  if (in.texture >= 0) return names.at(size_t(in.texture));
+  return isFloat ? Json(num(in.value.r)) : rgb(in.value);
+}
+
+Json namedTexture(const scene::TextureDef& t, const std::vector<std::string>& names, const std::filesystem::path& jp) {
+  using K = scene::TextureDef::Kind;
+  Json j;
+  auto uv = [&]() {
+    j["uscale"] = num(t.uscale);
+    j["vscale"] = num(t.vscale);
+    j["udelta"] = num(t.udelta);
+    j["vdelta"] = num(t.vdelta);
+  };
+  switch (t.kind) {
+    case K::Constant: j["type"] = "constant"; j["value"] = texInput(t.a, t.isFloat, names); break;
+    case K::Image:
+      j["type"] = "image";
+      j["file"] = relativeToJson(t.file, jp);
+      j["encoding"] = image::encodingName(t.encoding);
+      j["wrap"] = t.wrap == scene::TextureDef::Wrap::Repeat ? "repeat" : t.wrap == scene::TextureDef::Wrap::Clamp ? "clamp" : "black";
+      j["filter"] = t.filter == scene::TextureDef::Filter::Bilinear ? "bilinear" : "point";
+      j["scale"] = num(t.scale);
+      j["invert"] = t.invert;
+      uv();
+      break;
+    case K::Scale:
+      j["type"] = "scale";
+      j["texture"] = texInput(t.a, t.isFloat, names);
+      j["scale"] = texInput(t.b, true, names);
+      break;
+    case K::Mix:
+      j["type"] = "mix";
+      j["tex1"] = texInput(t.a, t.isFloat, names);
+      j["tex2"] = texInput(t.b, t.isFloat, names);
+      j["amount"] = texInput(t.amount, true, names);
+      break;
+    case K::Checkerboard:
+    case K::Checker3D:
+      j["type"] = t.kind == K::Checkerboard ? "checkerboard" : "checker3d";
+      j["tex1"] = texInput(t.a, t.isFloat, names);
+      j["tex2"] = texInput(t.b, t.isFloat, names);
+      if (t.kind == K::Checkerboard) uv();
+      else j["scale"] = num(t.cell);
+      break;
+  }
+  if (t.isFloat) j["float"] = true;
+  return j;
+}
+
+Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDesc>& materials,
+              const std::vector<std::string>& textures) {
   using T = scene::MaterialDesc::Type;
   Json j;
   auto albedo = [&]() {
-    if (m.albedo.kind == scene::TextureDesc::Kind::Constant) j["color"] = rgb(m.albedo.color);
+    if (m.albedoTexture >= 0) j["texture"] = textures.at(size_t(m.albedoTexture));
+    else if (m.albedo.kind == scene::TextureDesc::Kind::Constant) j["color"] = rgb(m.albedo.color);
     else j["texture"] = texture(m.albedo);
   };
+  Json spec = m.specularTexture >= 0 ? Json(textures.at(size_t(m.specularTexture))) : rgb(m.specular);
   switch (m.type) {
     case T::Diffuse: j["type"] = "diffuse"; albedo(); break;
-    case T::Mirror: j["type"] = "mirror"; j["color"] = rgb(m.specular); break;
-    case T::Dielectric: j["type"] = "dielectric"; j["ior"] = num(m.ior); j["tint"] = rgb(m.specular); break;
-    case T::Metal: j["type"] = "metal"; j["color"] = rgb(m.specular); j["roughness"] = num(m.roughness); break;
+    case T::Mirror: j["type"] = "mirror"; j["color"] = spec; break;
+    case T::Dielectric: j["type"] = "dielectric"; j["ior"] = num(m.ior); j["tint"] = spec; break;
+    case T::Metal: j["type"] = "metal"; j["color"] = spec; j["roughness"] = num(m.roughness); break;
     case T::Plastic:
       j["type"] = "plastic";
       albedo();
@@ -102,7 +178,7 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
     case T::RoughDielectric:
       j["type"] = "dielectric";
       j["ior"] = num(m.ior);
-      j["tint"] = rgb(m.specular);
+      j["tint"] = spec;
       j["roughness"] = num(m.roughness);
       break;
     case T::Uber:
@@ -149,9 +225,14 @@ std::string objNumber(float v) {
 std::string objText(const scene::ShapeDesc& s) {
   std::string out = "# written by tdpm convert\n";
   for (Vec3f v : s.vertices) out += "v " + objNumber(v.x) + " " + objNumber(v.y) + " " + objNumber(v.z) + "\n";
-  for (size_t i = 0; i + 2 < s.indices.size(); i += 3)
-    out += "f " + std::to_string(s.indices[i] + 1) + " " + std::to_string(s.indices[i + 1] + 1) + " " +
-           std::to_string(s.indices[i + 2] + 1) + "\n";
+  const bool uv = s.uvs.size() == s.indices.size();
+  if (uv)
+    for (Vec2f t : s.uvs) out += "vt " + objNumber(t.x) + " " + objNumber(t.y) + "\n";
+  // With uv, corner k of the file's faces is vt k + 1 (one vt per corner).
+  auto corner = [&](size_t k) {
+    return std::to_string(s.indices[k] + 1) + (uv ? "/" + std::to_string(k + 1) : std::string());
+  };
+  for (size_t i = 0; i + 2 < s.indices.size(); i += 3) out += "f " + corner(i) + " " + corner(i + 1) + " " + corner(i + 2) + "\n";
   return out;
 }
 
@@ -237,10 +318,16 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
     cam["focal_distance"] = num(c.focalDistance);
   }
   root["camera"] = cam;
+  std::vector<std::string> texNames = textureNames(sc.textures);
+  if (!sc.textures.empty()) {
+    Json textures = Json::object();
+    for (size_t i = 0; i < sc.textures.size(); ++i) textures[texNames[i]] = namedTexture(sc.textures[i], texNames, jp);
+    root["textures"] = textures;
+  }
   Json materials = Json::object();
   for (const auto& m : sc.materials) {
     if (materials.contains(m.name)) throw Error(jsonPath + ": two materials are named \"" + m.name + "\"");
-    materials[m.name] = material(m, sc.materials);
+    materials[m.name] = material(m, sc.materials, texNames);
   }
   root["materials"] = materials;
   Json objects = Json::array();

@@ -24,6 +24,9 @@ constexpr uint64_t kMaxMeshFileBytes = uint64_t(1) << 30;  // 1 GiB
 // triangles): about what the largest mesh file holds, so that a small file
 // asking for many levels cannot ask for more memory than a large one.
 constexpr uint64_t kMaxSubdividedTriangles = uint64_t(1) << 24;
+// Textures whose inputs are textures: how deep the chain may go (the
+// renderer evaluates it recursively, once per shaded hit).
+constexpr size_t kMaxTextureDepth = 64;
 // Deepest nesting of arrays/objects in a scene file. The deepest valid key
 // path is 6 levels (objects[i].motion[j].rotate.axis[k]); checked before
 // nlohmann-json parses, since nlohmann's parser recurses.

@@ -53,6 +53,13 @@ struct Material {
   uint32_t mixOf[2] = {0, 0};  // mix: the two materials' indices
   float mixAmount = 0.5f;      // mix: probability of mixOf[1]
   bool mixDelta = false, mixCaustic = false;  // mix: a component is delta-only / a caustic bounce (set at build)
+  // >= 0: the albedo is this node of Scene::textures (evaluated at the hit's
+  // uv, scene/texture.h) instead of `albedo` above.
+  int32_t albedoTexture = -1;
+  // >= 0: `specular` (mirror / metal reflectance, dielectric tint) is this
+  // node at the hit (Scene::shadedMaterial). Classification (isGlossy, ...)
+  // does not depend on it.
+  int32_t specularTexture = -1;
 
   // Purely delta (mirror, glass, smooth conductor): no photon is stored
   // here, no light sampling.

@@ -160,7 +160,8 @@ bool precheck(const std::string& path, const std::string& name, std::vector<size
 
 // Appends one polygon's triangles; false (with `problem`) on a bad index.
 bool addPolygon(const tinyobj::index_t* corners, size_t n, size_t face, size_t vertexCount, ObjMesh* mesh,
-                const std::vector<size_t>& faceLines, std::string* problem) {
+                const std::vector<size_t>& faceLines, std::string* problem, const tinyobj::attrib_t& attrib,
+                bool* allUv) {
   for (size_t k = 0; k < n; ++k) {
     int v = corners[k].vertex_index;
     if (v < 0 || size_t(v) >= vertexCount) {
@@ -171,7 +172,22 @@ bool addPolygon(const tinyobj::index_t* corners, size_t n, size_t face, size_t v
       return false;
     }
   }
+  const size_t uvCount = attrib.texcoords.size() / 2;
+  for (size_t k = 0; k < n && *allUv; ++k) {
+    int t = corners[k].texcoord_index;
+    if (t < 0) *allUv = false;  // a face without vt: no uv for the mesh
+    else if (size_t(t) >= uvCount) {
+      *problem = (face < faceLines.size() ? "line " + std::to_string(faceLines[face]) + ": " : std::string()) + "face " +
+                 std::to_string(face + 1) + " uses texture coordinate " + std::to_string(int64_t(t) + 1) +
+                 " but the file has " + std::to_string(uvCount);
+      return false;
+    }
+  }
+  auto uv = [&](const tinyobj::index_t& c) {
+    return Vec2f{float(attrib.texcoords[2 * size_t(c.texcoord_index)]), float(attrib.texcoords[2 * size_t(c.texcoord_index) + 1])};
+  };
   for (size_t k = 1; k + 1 < n; ++k) {
+    if (*allUv) mesh->uvs.insert(mesh->uvs.end(), {uv(corners[0]), uv(corners[k]), uv(corners[k + 1])});
     mesh->indices.push_back(uint32_t(corners[0].vertex_index));
     mesh->indices.push_back(uint32_t(corners[k].vertex_index));
     mesh->indices.push_back(uint32_t(corners[k + 1].vertex_index));
@@ -193,17 +209,20 @@ bool collectVertices(const tinyobj::attrib_t& attrib, ObjMesh* mesh, std::string
   return true;
 }
 
-bool collectFaces(const std::vector<tinyobj::shape_t>& shapes, ObjMesh* mesh, const std::vector<size_t>& faceLines,
-                  std::string* problem) {
+bool collectFaces(const std::vector<tinyobj::shape_t>& shapes, const tinyobj::attrib_t& attrib, ObjMesh* mesh,
+                  const std::vector<size_t>& faceLines, std::string* problem) {
   size_t face = 0;
+  bool allUv = true;
   for (const auto& shape : shapes) {
     size_t offset = 0;
     for (size_t n : shape.mesh.num_face_vertices) {
-      if (!addPolygon(&shape.mesh.indices[offset], n, face++, mesh->vertices.size(), mesh, faceLines, problem))
+      if (!addPolygon(&shape.mesh.indices[offset], n, face++, mesh->vertices.size(), mesh, faceLines, problem, attrib,
+                      &allUv))
         return false;
       offset += n;
     }
   }
+  if (!allUv || mesh->uvs.size() != mesh->indices.size()) mesh->uvs.clear();
   return true;
 }
 
@@ -232,7 +251,7 @@ bool loadObjMesh(const std::string& path, ObjMesh* mesh, std::string* problem) {
     return false;
   }
   *mesh = ObjMesh{};
-  if (!collectVertices(reader.GetAttrib(), mesh, &why) || !collectFaces(reader.GetShapes(), mesh, faceLines, &why)) {
+  if (!collectVertices(reader.GetAttrib(), mesh, &why) || !collectFaces(reader.GetShapes(), reader.GetAttrib(), mesh, faceLines, &why)) {
     *problem = name + (why.compare(0, 5, "line ") == 0 ? ", " : ": ") + why;
     return false;
   }

@@ -13,10 +13,13 @@ namespace tdpm::scene {
 struct ObjMesh {
   std::vector<Vec3f> vertices;
   std::vector<uint32_t> indices;  // 3 per triangle
+  // (u, v) per triangle corner from the faces' vt indices, when every face
+  // has them (else empty: the renderer's default per triangle).
+  std::vector<Vec2f> uvs;
 };
 
 // Loads every face of every group of `path`, triangulated (polygons are
-// split, normals/uvs/materials ignored). On failure returns false and sets
+// split; vt texture coordinates kept, normals/materials ignored). On failure returns false and sets
 // `problem` to a message naming the file, e.g.
 //   mesh "meshes/bad.obj": face 3 uses vertex 9 but the file has 4 vertices
 bool loadObjMesh(const std::string& path, ObjMesh* mesh, std::string* problem);

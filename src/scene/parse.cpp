@@ -13,11 +13,15 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <optional>
+#include <set>
 #include <sstream>
 
 #include "core/error.h"
 #include "math/bounds.h"
 #include "motion/motion.h"
+#include "image/texture_image.h"
 #include "scene/environment.h"
 #include "scene/json_locate.h"
 #include "scene/limits.h"
@@ -360,13 +364,204 @@ TextureDesc readTexture(const Node& n) {
   return t;
 }
 
-// Diffuse reflectance / plastic base colour: "color" or "texture".
-TextureDesc readAlbedo(const Node& n) {
+// ---------------------------------------------------------------- named textures
+// "textures": {"name": {...}} (docs/scene-format.md, "Textures"). Inputs
+// name other textures, so they are read on demand (JSON objects have no
+// order) with a cycle check; each lands in SceneDescription::textures after
+// its inputs. Images are read once per (file, encoding).
+std::string resolveMeshPath(const std::string& file, const std::string& sceneDir);
+
+class TextureReader {
+ public:
+  TextureReader(const Node& block, const std::string& sceneDir, std::vector<TextureDef>* out)
+      : block_(block), sceneDir_(sceneDir), out_(out) {}
+
+  void readAll() {
+    block_.forEachMember([&](const std::string& name, const Node& n) { index(name, n); });
+  }
+  // The index of texture `name` (reading it first if needed); `from` is
+  // where the reference was written, for the error.
+  int32_t index(const std::string& name, const Node& from) {
+    auto done = indices_.find(name);
+    if (done != indices_.end()) return done->second;
+    if (!block_.has(name)) {
+      std::vector<std::string> names;
+      block_.forEachMember([&](const std::string& k, const Node&) { names.push_back(k); });
+      from.fail("unknown texture \"" + name + "\"; " +
+                (names.empty() ? "no textures are defined" : "defined textures: " + joinNames(names)));
+    }
+    if (reading_.count(name)) from.fail("texture \"" + name + "\" refers to itself (through its inputs)");
+    from.require(reading_.size() < limits::kMaxTextureDepth,
+                 "textures nest more than " + std::to_string(limits::kMaxTextureDepth) + " deep");
+    reading_.insert(name);
+    TextureDef t = read(block_.member(name), name);
+    reading_.erase(name);
+    out_->push_back(std::move(t));
+    int32_t i = int32_t(out_->size() - 1);
+    indices_[name] = i;
+    return i;
+  }
+  std::vector<TextureDef>* out() const { return out_; }
+
+ private:
+  // A number, [r, g, b] or a texture's name; `isFloat`: a float input (a
+  // number, or a float texture).
+  TexInput input(const Node& n, bool isFloat, const char* what) {
+    TexInput in;
+    if (n.json().is_string()) {
+      in.texture = index(n.string(), n);
+      bool f = (*out_)[size_t(in.texture)].isFloat;
+      if (f != isFloat)
+        n.fail(std::string(what) + ": texture \"" + n.string() + "\" is a " + (f ? "float" : "spectrum (RGB)") +
+               " texture, but a " + (isFloat ? "float" : "spectrum (RGB)") + " one is expected here");
+      return in;
+    }
+    if (isFloat) {
+      in.value = Rgb(n.number());
+      n.require(in.value.r >= 0, std::string(what) + " must not be negative");
+    } else {
+      in.value = n.color();
+    }
+    return in;
+  }
+  void readUvMapping(const Node& n, TextureDef* t) {
+    if (n.has("uscale")) t->uscale = n.member("uscale").number();
+    if (n.has("vscale")) t->vscale = n.member("vscale").number();
+    if (n.has("udelta")) t->udelta = n.member("udelta").number();
+    if (n.has("vdelta")) t->vdelta = n.member("vdelta").number();
+  }
+  TextureDef read(const Node& n, const std::string& name);
+  void readImage(const Node& n, TextureDef* t);
+
+  Node block_;
+  std::string sceneDir_;
+  std::vector<TextureDef>* out_;
+  std::map<std::string, int32_t> indices_;
+  std::set<std::string> reading_;
+  std::map<std::pair<std::string, std::string>, std::shared_ptr<const image::ImageRgb>> images_;
+};
+
+void TextureReader::readImage(const Node& n, TextureDef* t) {
+  Node f = n.required("file");
+  std::string file = f.string();
+  f.require(!file.empty(), "texture file name must not be empty");
+  t->file = resolveMeshPath(file, sceneDir_);
+  if (n.has("encoding")) {
+    Node e = n.member("encoding");
+    std::string s = e.string();
+    if (s == "sRGB") t->encoding.kind = image::TexelEncoding::Kind::Srgb;
+    else if (s == "linear") t->encoding.kind = image::TexelEncoding::Kind::Linear;
+    else if (s.compare(0, 6, "gamma ") == 0) {
+      char* end = nullptr;
+      double g = std::strtod(s.c_str() + 6, &end);
+      e.require(end && *end == 0 && g > 0 && g < 100, "encoding \"" + s + "\": the gamma must be a number in (0, 100)");
+      t->encoding = {image::TexelEncoding::Kind::Gamma, float(g)};
+    } else {
+      e.fail("unknown encoding \"" + s + "\" (sRGB, linear or \"gamma <g>\")");
+    }
+  }
+  if (n.has("wrap")) {
+    std::string w = n.member("wrap").choice({"repeat", "clamp", "black"}, "wrap mode");
+    t->wrap = w == "repeat" ? TextureDef::Wrap::Repeat : w == "clamp" ? TextureDef::Wrap::Clamp : TextureDef::Wrap::Black;
+  }
+  if (n.has("filter"))
+    t->filter = n.member("filter").choice({"bilinear", "point"}, "texture filter") == "point" ? TextureDef::Filter::Point
+                                                                                             : TextureDef::Filter::Bilinear;
+  if (n.has("scale")) {
+    t->scale = n.member("scale").number();
+    n.member("scale").require(t->scale >= 0, "scale must not be negative, got " + fmt(t->scale));
+  }
+  if (n.has("invert")) {
+    Node v = n.member("invert");
+    v.require(v.json().is_boolean(), "expected true or false, got " + detail::describeKind(v.json()));
+    t->invert = v.json().get<bool>();
+  }
+  auto key = std::make_pair(t->file, image::encodingName(t->encoding));
+  auto& img = images_[key];
+  if (!img) {
+    try {
+      img = std::make_shared<const image::ImageRgb>(image::readTextureImage(t->file, t->encoding));
+    } catch (const Error& e) {
+      images_.erase(key);
+      f.fail(e.what());
+    }
+  }
+  t->image = img;
+}
+
+TextureDef TextureReader::read(const Node& n, const std::string& name) {
+  n.requireObject();
+  std::string kind =
+      n.required("type").choice({"constant", "image", "scale", "mix", "checkerboard", "checker3d"}, "texture type");
+  TextureDef t;
+  t.name = name;
+  if (n.has("float")) {
+    Node v = n.member("float");
+    v.require(v.json().is_boolean(), "expected true or false, got " + detail::describeKind(v.json()));
+    t.isFloat = v.json().get<bool>();
+  }
+  const std::vector<std::string> uv = {"uscale", "vscale", "udelta", "vdelta"};
+  auto keys = [&](std::vector<std::string> k, bool mapping) {
+    k.insert(k.end(), {"type", "float"});
+    if (mapping) k.insert(k.end(), uv.begin(), uv.end());
+    n.expectObject(k);
+  };
+  if (kind == "constant") {
+    keys({"value"}, false);
+    t.kind = TextureDef::Kind::Constant;
+    t.a = input(n.required("value"), t.isFloat, "value");
+  } else if (kind == "image") {
+    keys({"file", "encoding", "wrap", "filter", "scale", "invert"}, true);
+    t.kind = TextureDef::Kind::Image;
+    readUvMapping(n, &t);
+    readImage(n, &t);
+  } else if (kind == "scale") {
+    keys({"texture", "scale"}, false);
+    t.kind = TextureDef::Kind::Scale;
+    if (n.has("texture")) t.a = input(n.member("texture"), t.isFloat, "texture");
+    if (n.has("scale")) t.b = input(n.member("scale"), true, "scale");
+  } else if (kind == "mix") {
+    keys({"tex1", "tex2", "amount"}, false);
+    t.kind = TextureDef::Kind::Mix;
+    t.a.value = Rgb(0.0f);
+    t.amount.value = Rgb(0.5f);
+    if (n.has("tex1")) t.a = input(n.member("tex1"), t.isFloat, "tex1");
+    if (n.has("tex2")) t.b = input(n.member("tex2"), t.isFloat, "tex2");
+    if (n.has("amount")) t.amount = input(n.member("amount"), true, "amount");
+  } else {
+    bool flat = kind == "checkerboard";
+    keys(flat ? std::vector<std::string>{"tex1", "tex2"} : std::vector<std::string>{"tex1", "tex2", "scale"}, flat);
+    t.kind = flat ? TextureDef::Kind::Checkerboard : TextureDef::Kind::Checker3D;
+    t.b.value = Rgb(0.0f);
+    if (n.has("tex1")) t.a = input(n.member("tex1"), t.isFloat, "tex1");
+    if (n.has("tex2")) t.b = input(n.member("tex2"), t.isFloat, "tex2");
+    if (flat) readUvMapping(n, &t);
+    else if (n.has("scale")) {
+      t.cell = readPositive(n.member("scale"), "checker3d scale (cell size)");
+      n.member("scale").require(std::isfinite(1.0f / t.cell), "checker3d scale " + fmt(t.cell) + " is too small");
+    }
+  }
+  return t;
+}
+
+// Diffuse reflectance / plastic base colour: "color", or "texture" (an
+// inline constant or checker, or the name of a spectrum texture).
+TextureDesc readAlbedo(const Node& n, TextureReader* textures, int32_t* named) {
   if (n.has("color") && n.has("texture"))
     n.member("texture").fail("give either \"color\" or \"texture\", not both");
   TextureDesc t;
   if (n.has("color")) t.color = readReflectance(n.member("color"));
-  if (n.has("texture")) t = readTexture(n.member("texture"));
+  if (n.has("texture")) {
+    Node tn = n.member("texture");
+    if (tn.json().is_string()) {
+      if (!textures) tn.fail("unknown texture \"" + tn.string() + "\"; no textures are defined");
+      *named = textures->index(tn.string(), tn);
+      const TextureDef& d = (*textures->out())[size_t(*named)];
+      if (d.isFloat) tn.fail("texture \"" + tn.string() + "\" is a float texture, but a spectrum (RGB) one is expected here");
+    } else {
+      t = readTexture(tn);
+    }
+  }
   return t;
 }
 
@@ -435,7 +630,8 @@ const std::vector<MaterialKind>& materialKinds() {
 }
 
 // mixNames: a mix's two component names, resolved by readMaterials.
-MaterialDesc readMaterial(const Node& n, const std::string& name, std::vector<std::string>* mixNames) {
+MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader* textures,
+                          std::vector<std::string>* mixNames) {
   using T = MaterialDesc::Type;
   n.requireObject();
   std::vector<std::string> names;
@@ -462,15 +658,26 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, std::vector<st
     }
     return m;
   }
+  // A specular colour: a reflectance, or the name of a spectrum texture.
+  auto specular = [&](const Node& c) {
+    if (!c.json().is_string()) {
+      m.specular = readReflectance(c);
+      return;
+    }
+    if (!textures) c.fail("unknown texture \"" + c.string() + "\"; no textures are defined");
+    m.specularTexture = textures->index(c.string(), c);
+    if ((*textures->out())[size_t(m.specularTexture)].isFloat)
+      c.fail("texture \"" + c.string() + "\" is a float texture, but a spectrum (RGB) one is expected here");
+  };
   if (kind.type == T::Conductor || kind.type == T::CoatedConductor) {
     readConductor(n, &m);
   } else {
     bool albedo = kind.type == T::Diffuse || kind.type == T::Plastic || kind.type == T::Uber ||
                   kind.type == T::Substrate || kind.type == T::CoatedDiffuse;
-    if (albedo) m.albedo = readAlbedo(n);
-    else if (n.has("color")) m.specular = readReflectance(n.member("color"));
+    if (albedo) m.albedo = readAlbedo(n, textures, &m.albedoTexture);
+    else if (n.has("color")) specular(n.member("color"));
   }
-  if (n.has("tint")) m.specular = readReflectance(n.member("tint"));
+  if (n.has("tint")) specular(n.member("tint"));
   if (n.has("specular")) m.specular = readReflectance(n.member("specular"));
   else if (kind.type == T::Uber || kind.type == T::Substrate) m.specular = Rgb(0.25f);  // pbrt-v3's Ks
   if (n.has("ior")) m.ior = readIor(n.member("ior"));
@@ -488,14 +695,14 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, std::vector<st
   return m;
 }
 
-std::vector<MaterialDesc> readMaterials(const Node& n) {
+std::vector<MaterialDesc> readMaterials(const Node& n, TextureReader* textures) {
   std::vector<MaterialDesc> out;
   std::vector<std::pair<size_t, std::vector<std::string>>> mixes;
   std::vector<Node> nodes;
   n.forEachMember([&](const std::string& name, const Node& m) {
     m.require(!name.empty(), "material names must not be empty");
     std::vector<std::string> mixNames;
-    out.push_back(readMaterial(m, name, &mixNames));
+    out.push_back(readMaterial(m, name, textures, &mixNames));
     nodes.push_back(m);
     if (!mixNames.empty()) mixes.push_back({out.size() - 1, mixNames});
   });
@@ -595,7 +802,11 @@ void readMesh(const Node& n, const std::string& sceneDir, ShapeDesc* shape) {
   if (!loadObjMesh(shape->meshFile, &mesh, &problem)) fileNode.fail(problem);
   shape->vertices = std::move(mesh.vertices);
   shape->indices = std::move(mesh.indices);
-  if (n.has("subdivision")) readSubdivision(n.member("subdivision"), shape);
+  shape->uvs = std::move(mesh.uvs);
+  if (n.has("subdivision")) {
+    readSubdivision(n.member("subdivision"), shape);
+    shape->uvs.clear();  // the refined triangles are new: pbrt's default uv each
+  }
 }
 
 // Disk: radius > 0, 0 <= inner_radius < radius, any height; cylinder:
@@ -1047,15 +1258,20 @@ RenderSettings readRender(const Node& n, float shutterLength) {
 // ---------------------------------------------------------------- scene
 
 SceneDescription readScene(const Node& root, const std::string& sourcePath) {
-  root.expectObject({"camera", "materials", "objects", "lights", "background", "render", "animation"});
+  root.expectObject({"camera", "textures", "materials", "objects", "lights", "background", "render", "animation"});
   SceneDescription scene;
   scene.sourcePath = sourcePath;
   if (root.has("animation")) scene.animation = readAnimation(root.member("animation"));
   scene.camera = readCamera(root.required("camera"), scene.animation);
   Shutter shutter{scene.camera.shutterOpen, scene.camera.shutterClose,
                   scene.animation ? "the animation" : "the shutter"};
-  if (root.has("materials")) scene.materials = readMaterials(root.member("materials"));
   std::string sceneDir = std::filesystem::path(sourcePath).parent_path().string();
+  std::optional<TextureReader> textures;
+  if (root.has("textures")) {
+    textures.emplace(root.member("textures"), sceneDir, &scene.textures);
+    textures->readAll();
+  }
+  if (root.has("materials")) scene.materials = readMaterials(root.member("materials"), textures ? &*textures : nullptr);
   Node objects = root.required("objects");
   size_t count = objects.arraySize("objects");
   for (size_t i = 0; i < count; ++i)

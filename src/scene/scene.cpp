@@ -59,6 +59,8 @@ bool Scene::intersect(Vec3f o, Vec3f d, float tFar, float time01, Hit& hit) cons
   }
   hit.light = -1;
   hit.object = uint32_t(owner);
+  hit.primitive = raw.primitiveId;
+  hit.bary = {raw.u, raw.v};
   const SceneObject& obj = objects[size_t(owner)];
   if (!obj.motion.moving()) {
     // Static: world-space normals and the inverse placement were made once.
@@ -76,6 +78,35 @@ bool Scene::intersect(Vec3f o, Vec3f d, float tFar, float time01, Hit& hit) cons
   }
   if (obj.reverseOrientation) hit.n = -hit.n;
   return true;
+}
+
+Vec2f Scene::uvAt(const Hit& hit) const {
+  const SceneObject& obj = objects[hit.object];
+  if (obj.kind == SceneObject::Kind::Sphere) {
+    Vec3f q = hit.localP;
+    float r = length(q);
+    float phi = std::atan2(q.y, q.x);
+    if (phi < 0) phi += 2 * kPi;
+    float theta = r > 0 ? std::acos(std::clamp(q.z / r, -1.0f, 1.0f)) : 0.0f;
+    return {phi / (2 * kPi), 1.0f - theta / kPi};  // pbrt: v = (theta - pi) / (0 - pi)
+  }
+  if (obj.kind == SceneObject::Kind::Quadric) {
+    // pbrt's parameterisation: u = phi / phiMax; a disk's v runs from its rim
+    // (0) to its inner radius (1), a cylinder's from zMin (0) to zMax (1).
+    const Quadric& q = obj.quadric;
+    Vec3f p = hit.localP;
+    float phi = std::atan2(p.y, p.x);
+    if (phi < 0) phi += 2 * kPi;
+    float u = std::clamp(phi / q.phiMax, 0.0f, 1.0f);
+    float v = q.kind == Quadric::Kind::Disk
+                  ? (q.radius - std::sqrt(p.x * p.x + p.y * p.y)) / (q.radius - q.innerRadius)
+                  : (p.z - q.zMin) / (q.zMax - q.zMin);
+    return {u, std::clamp(v, 0.0f, 1.0f)};
+  }
+  float b1 = hit.bary.x, b2 = hit.bary.y, b0 = 1 - b1 - b2;
+  if (obj.uvs.empty()) return {b1 + b2, b2};  // corners (0,0), (1,0), (1,1)
+  const Vec2f* c = &obj.uvs[size_t(hit.primitive) * 3];
+  return {b0 * c[0].x + b1 * c[1].x + b2 * c[2].x, b0 * c[0].y + b1 * c[1].y + b2 * c[2].y};
 }
 
 bool Scene::segmentMeetsMotion(Vec3f o, Vec3f d, float tMax) const {

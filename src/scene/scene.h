@@ -3,7 +3,9 @@
 // queries (through EmbreeScene) that return fully shaded hit records.
 // Built once per render from a validated SceneDescription; read-only after.
 #pragma once
+#include <algorithm>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +17,7 @@
 #include "scene/light.h"
 #include "scene/material.h"
 #include "scene/quadric.h"
+#include "scene/texture.h"
 
 namespace tdpm {
 
@@ -29,6 +32,7 @@ struct SceneObject {
   Bounds3f objectBounds;            // object space
   Bounds3f sweptBounds;             // world, over the whole shutter
   std::vector<Vec3f> faceNormals;   // triangles: object-space unit normals
+  std::vector<Vec2f> uvs;           // triangles: (u, v) per corner, or empty (pbrt's default per triangle)
   // Static objects only (precomputed, so a hit costs no matrix inverse):
   std::vector<Vec3f> worldNormals;  // triangles: world-space unit normals
   Vec3f worldCentre;                // sphere centre
@@ -41,6 +45,8 @@ struct Hit {
   Vec3f n;             // outward geometric normal, world, unit
   Vec3f localP;        // object-space position (textures)
   uint32_t object = 0; // index into objects (when !isLight)
+  uint32_t primitive = 0;  // triangle within the object
+  Vec2f bary;              // triangles: barycentrics of its vertices 1 and 2
   int32_t light = -1;  // index into lights when an area light was hit
   bool isLight() const { return light >= 0; }
 };
@@ -52,6 +58,27 @@ class Scene {
   // Closest hit along o + s d, s in (0, tFar), at normalised time time01.
   bool intersect(Vec3f o, Vec3f d, float tFar, float time01, Hit& hit) const;
   bool occluded(Vec3f o, Vec3f d, float tFar, float time01) const;
+  // The surface's (u, v) at a hit on an object: interpolated per triangle
+  // corner, or pbrt's sphere parameterisation (u = phi / 2 pi about local
+  // +z, v = theta / pi from the -z pole). Only textured materials ask.
+  Vec2f uvAt(const Hit& hit) const;
+  // The material's albedo at the hit: its texture node if it has one,
+  // clamped to [0, 1] as pbrt-v4 clamps a reflectance (energy).
+  Rgb albedoAt(const Material& m, const Hit& hit) const {
+    if (m.albedoTexture < 0) return m.albedo.at(hit.localP);
+    Rgb v = textures.eval(uint32_t(m.albedoTexture), {uvAt(hit), hit.localP});
+    return {std::clamp(v.r, 0.0f, 1.0f), std::clamp(v.g, 0.0f, 1.0f), std::clamp(v.b, 0.0f, 1.0f)};
+  }
+  // The material the BSDF sees at the hit: m itself, or (a textured
+  // specular colour) a copy in `scratch` with the value at the hit, clamped
+  // to [0, 1]. An empty optional costs an untextured hit nothing.
+  const Material& shadedMaterial(const Material& m, const Hit& hit, std::optional<Material>& scratch) const {
+    if (m.specularTexture < 0) return m;
+    Rgb v = textures.eval(uint32_t(m.specularTexture), {uvAt(hit), hit.localP});
+    scratch.emplace(m);
+    scratch->specular = {std::clamp(v.r, 0.0f, 1.0f), std::clamp(v.g, 0.0f, 1.0f), std::clamp(v.b, 0.0f, 1.0f)};
+    return *scratch;
+  }
   // The raw ray tracer (benchmarks compare our tracing against it).
   const EmbreeScene& embree() const { return embree_; }
   // Origin for a ray leaving surface point p (normal n) in direction d:
@@ -77,6 +104,7 @@ class Scene {
   Camera camera;
   Shutter shutter;
   std::vector<Material> materials;
+  TextureSet textures;
   std::vector<SceneObject> objects;
   std::vector<Light> lights;
   std::vector<uint32_t> environmentLights;  // indices into lights: what an escaping ray meets
