@@ -315,17 +315,17 @@ TEST_CASE("progressive: pass kernels follow alpha, and the half window stops at 
     o.alpha = alpha;
     double a3 = alpha > 0 ? alpha : 4.0 / 7.0;
     PassKernels k = kernelsForPass(st, o, *s, 9);
-    CHECK(k.caustic.radius == doctest::Approx(0.1 * kernelScale(9, a3, 3)));
-    CHECK(k.caustic.halfWindow == doctest::Approx(0.05 * kernelScale(9, a3, 3)));
-    CHECK(k.caustic.spatialRadius == doctest::Approx(0.2 * kernelScale(9, 2.0 / 3.0, 2)));  // time's fallback: 2/3
+    CHECK(k[MapKind::Caustic].radius == doctest::Approx(0.1 * kernelScale(9, a3, 3)));
+    CHECK(k[MapKind::Caustic].halfWindow == doctest::Approx(0.05 * kernelScale(9, a3, 3)));
+    CHECK(k[MapKind::Caustic].spatialRadius == doctest::Approx(0.2 * kernelScale(9, 2.0 / 3.0, 2)));  // time's fallback: 2/3
     // The global window would fall below a bin: floored there, r^2 h keeps the schedule.
     double s3 = kernelScale(9, a3, 3);
     CHECK(1.1 * s3 < 1.0);
-    CHECK(k.global.halfWindow == doctest::Approx(1.0 / 256.0));
-    CHECK(double(k.global.radius) * k.global.radius * k.global.halfWindow ==
+    CHECK(k[MapKind::Global].halfWindow == doctest::Approx(1.0 / 256.0));
+    CHECK(double(k[MapKind::Global].radius) * k[MapKind::Global].radius * k[MapKind::Global].halfWindow ==
           doctest::Approx(0.01 * s3 * s3 * (1.1 / 256.0) * s3).epsilon(1e-4));
   }
   o.method = RenderMethod::Standard;
   o.alpha = 0.5f;
-  CHECK(kernelsForPass(st, o, *s, 9).caustic.spatialRadius == doctest::Approx(0.2 * kernelScale(9, 0.5, 2)));
+  CHECK(kernelsForPass(st, o, *s, 9)[MapKind::Caustic].spatialRadius == doctest::Approx(0.2 * kernelScale(9, 0.5, 2)));
 }

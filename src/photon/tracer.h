@@ -16,13 +16,12 @@
 
 #include "core/progress.h"
 #include "distributed/comm.h"
+#include "photon/map_kind.h"
 #include "photon/store.h"
 #include "sampling/sampler.h"
 #include "scene/scene.h"
 
 namespace tdpm::photon {
-
-enum class MapKind : uint8_t { Caustic, Global };
 
 struct TraceSettings {
   MapKind kind = MapKind::Caustic;

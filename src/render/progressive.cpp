@@ -127,8 +127,11 @@ estimate::MapKernel pilotKernel(const PhotonMap* map, const Scene& scene, const 
   return k;
 }
 
-void storeKernel(ProgressiveState& st, const char* map, const estimate::MapKernel& k) {
-  std::string p = std::string("kernel.") + map + ".";
+// The state's names of a map's pass-0 values.
+std::string pathsKey(MapKind kind) { return std::string("photons.") + mapKindName(kind) + "_paths_per_pass"; }
+
+void storeKernel(ProgressiveState& st, MapKind kind, const estimate::MapKernel& k) {
+  std::string p = std::string("kernel.") + mapKindName(kind) + ".";
   st.scalars[p + "radius_1"] = double(k.radius);
   st.scalars[p + "half_window_1"] = double(k.halfWindow);
   st.scalars[p + "spatial_radius_1"] = double(k.spatialRadius);
@@ -220,18 +223,23 @@ void renderPassPixels(const Scene& scene, const PhotonIntegrator& integ, const R
 // fixed order (they cross the network under mpirun; counts stay exact
 // below 2^53).
 struct PassFigures {
-  double causticStored = 0, globalStored = 0, causticEmitted = 0, globalEmitted = 0;
+  PerMap<double> stored, emitted;
   double standardEstimates = 0, timeEstimates = 0, photonSeconds = 0, bytesPerPhoton = 0, seconds = 0;
-  static constexpr size_t kCount = 9;
+  static constexpr size_t kCount = 2 * kMapKinds + 5;
   std::vector<double> pack() const {
-    return {causticStored, globalStored, causticEmitted, globalEmitted, standardEstimates,
-            timeEstimates, photonSeconds, bytesPerPhoton, seconds};
+    std::vector<double> v;
+    for (MapKind k : kAllMapKinds) v.insert(v.end(), {stored[k], emitted[k]});
+    v.insert(v.end(), {standardEstimates, timeEstimates, photonSeconds, bytesPerPhoton, seconds});
+    return v;
   }
   static PassFigures unpack(const double* v) {
     PassFigures f;
-    f.causticStored = v[0], f.globalStored = v[1], f.causticEmitted = v[2], f.globalEmitted = v[3];
-    f.standardEstimates = v[4], f.timeEstimates = v[5], f.photonSeconds = v[6], f.bytesPerPhoton = v[7];
-    f.seconds = v[8];
+    for (MapKind k : kAllMapKinds) {
+      f.stored[k] = *v++;
+      f.emitted[k] = *v++;
+    }
+    f.standardEstimates = v[0], f.timeEstimates = v[1], f.photonSeconds = v[2], f.bytesPerPhoton = v[3];
+    f.seconds = v[4];
     return f;
   }
 };
@@ -303,41 +311,39 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
   const bool spread = method.spreadsPhotonsInTime && scene.hasMotion;
   const float passTime = accumulation && scene.hasMotion ? accumulationPassTime(pass, opt.seed) : -1.0f;
 
-  double photonSeconds = 0;
   // ---- photons: pass 0 sizes the emission with the tracer's pilot; later
   //      passes trace the same number of paths at the next path indices ----
-  auto trace = [&](photon::MapKind kind, size_t wanted, const char* key) -> std::unique_ptr<PhotonMap> {
-    PhotonMapSettings ms = photonMapSettingsFor(opt, kind, wanted, opt.seed, spread, passTime >= 0 ? passTime : 0.0f);
+  PerMap<PhotonMapSettings> settings =
+      photonMapSettingsFor(opt, photonsWanted(opt), opt.seed, spread, passTime >= 0 ? passTime : 0.0f);
+  for (MapKind kind : kAllMapKinds) {
+    photon::TraceSettings& ts = settings[kind].trace;
     if (std::isfinite(opt.frameOpen)) {  // an animation frame: its shutter alone (the fixed kernel clips its window to it)
-      ms.trace.timeOpen = opt.frameOpen;
-      ms.trace.timeClose = opt.frameClose;
+      ts.timeOpen = opt.frameOpen;
+      ts.timeClose = opt.frameClose;
     }
-    auto it = state.scalars.find(key);
-    if (it != state.scalars.end()) {
-      // A resumed value was checked (render/progressive_check.h): a whole
-      // number of batches, small enough for every pass index.
-      uint64_t paths = uint64_t(it->second);
-      if (paths == 0) ms.trace.storedWanted = 0;
-      ms.trace.paths = paths;
-      TDPM_ASSERT(paths == 0 || uint64_t(pass) + 1 <= UINT64_MAX / paths, "progressive photon path index overflows");
-      ms.trace.firstPath = uint64_t(pass) * paths;
-    }
-    std::unique_ptr<PhotonMap> m = buildPhotonMap(scene, ms, progress);
-    if (it == state.scalars.end()) state.scalars[key] = double(m->emitted);
-    photonSeconds += m->traceSeconds + m->buildSeconds;
-    if (!m->warning.empty() && pass == 0) st.warnings.push_back(m->warning);
-    return m;
-  };
-  const bool wantGlobal = wantsGlobalMap(opt);
-  std::unique_ptr<PhotonMap> caustic = trace(photon::MapKind::Caustic, opt.causticPhotons, "photons.caustic_paths_per_pass");
-  std::unique_ptr<PhotonMap> global =
-      trace(photon::MapKind::Global, wantGlobal ? opt.globalPhotons : 0, "photons.global_paths_per_pass");
+    auto it = state.scalars.find(pathsKey(kind));
+    if (it == state.scalars.end()) continue;
+    // A resumed value was checked (render/progressive_check.h): a whole
+    // number of batches, small enough for every pass index.
+    uint64_t paths = uint64_t(it->second);
+    if (paths == 0) ts.storedWanted = 0;
+    ts.paths = paths;
+    TDPM_ASSERT(paths == 0 || uint64_t(pass) + 1 <= UINT64_MAX / paths, "progressive photon path index overflows");
+    ts.firstPath = uint64_t(pass) * paths;
+  }
+  PhotonMaps maps = buildPhotonMaps(scene, settings, progress);
+  double photonSeconds = 0;
+  for (MapKind kind : kAllMapKinds) {
+    const PhotonMap& m = *maps[kind];
+    if (!state.scalars.count(pathsKey(kind))) state.scalars[pathsKey(kind)] = double(m.emitted);
+    photonSeconds += m.traceSeconds + m.buildSeconds;
+    if (!m.warning.empty() && pass == 0) st.warnings.push_back(m.warning);
+  }
 
   // ---- kernels: pass 1's from a k-NN pilot on pass 0's maps ----
   const bool timeDependent = renderMethodTraits(opt.method).timeDependentEstimate && scene.hasMotion;
   if (!hasPilot(state)) {
-    storeKernel(state, "caustic", pilotKernel(caustic.get(), scene, opt, timeDependent));
-    storeKernel(state, "global", pilotKernel(global.get(), scene, opt, timeDependent));
+    for (MapKind kind : kAllMapKinds) storeKernel(state, kind, pilotKernel(maps[kind], scene, opt, timeDependent));
     if (afterPilot) afterPilot();
   }
   PassKernels k = kernelsForPass(state, opt, scene, pass);
@@ -348,9 +354,8 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
   is.visualizeGlobal = opt.visualizeGlobal;
   is.maxDepth = opt.maxDepth;
   is.fixedKernels = true;
-  is.causticKernel = k.caustic;
-  is.globalKernel = k.global;
-  PhotonIntegrator integ(scene, caustic.get(), global.get(), is);
+  is.kernels = k;
+  PhotonIntegrator integ(scene, maps.view(), is);
   std::string stage = "pass " + std::to_string(pass + 1) + " render";
   if (opt.sampler == SamplerKind::Random)
     renderPassPixels<RandomPixelSampler>(scene, integ, opt, pass, opt.spp, counts, passTime, stage, progress, mean);
@@ -361,14 +366,11 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
   EstimateCounts c = integ.counts();
   f.standardEstimates = double(c.standard);
   f.timeEstimates = double(c.timeDependent);
-  f.causticStored = double(caustic->size());
-  f.globalStored = double(global->size());
-  f.causticEmitted = double(caustic->emitted);
-  f.globalEmitted = double(global->emitted);
-  size_t n = caustic->size() + global->size();
-  if (n > 0)
-    f.bytesPerPhoton = (caustic->bytesPerPhoton() * double(caustic->size()) +
-                        global->bytesPerPhoton() * double(global->size())) / double(n);
+  for (MapKind kind : kAllMapKinds) {
+    f.stored[kind] = double(maps[kind]->size());
+    f.emitted[kind] = double(maps[kind]->emitted);
+  }
+  f.bytesPerPhoton = maps.bytesPerPhoton();
   f.photonSeconds = photonSeconds;
   f.seconds = timer.seconds();
   return f;
@@ -417,22 +419,27 @@ std::string addPass(const Scene& scene, const RenderOptions& opt, ProgressiveSta
   }
   st.standardEstimates += uint64_t(f.standardEstimates);
   st.timeEstimates += uint64_t(f.timeEstimates);
-  st.causticStored += size_t(f.causticStored);
-  st.globalStored += size_t(f.globalStored);
-  st.causticEmitted += uint64_t(f.causticEmitted);
-  st.globalEmitted += uint64_t(f.globalEmitted);
+  double emitted = 0, stored = 0;  // over the maps, in kind order
+  for (MapKind k : kAllMapKinds) {
+    st.maps[k].stored += size_t(f.stored[k]);
+    st.maps[k].emitted += uint64_t(f.emitted[k]);
+    emitted += f.emitted[k];
+    stored += f.stored[k];
+  }
   st.photonSeconds += f.photonSeconds;
-  if (f.causticStored + f.globalStored > 0) st.bytesPerPhoton = f.bytesPerPhoton;
+  if (stored > 0) st.bytesPerPhoton = f.bytesPerPhoton;
 
   const bool timeDependent = renderMethodTraits(opt.method).timeDependentEstimate && scene.hasMotion;
   PassKernels k = kernelsForPass(state, opt, scene, pass);
   state.passesDone = pass + 1;
   auto& sc = state.scalars;
-  sc["photons.emitted"] = scalarOr(state, "photons.emitted", 0) + (f.causticEmitted + f.globalEmitted);
-  sc["photons.stored"] = scalarOr(state, "photons.stored", 0) + (f.causticStored + f.globalStored);
-  sc["kernel.radius"] = double(timeDependent ? k.caustic.radius : k.caustic.spatialRadius);
-  sc["kernel.spatial_radius"] = double(k.caustic.spatialRadius);
-  sc["kernel.half_window"] = timeDependent ? double(k.caustic.halfWindow) : 0.0;
+  sc["photons.emitted"] = scalarOr(state, "photons.emitted", 0) + emitted;
+  sc["photons.stored"] = scalarOr(state, "photons.stored", 0) + stored;
+  // Reported (not read back): the caustic map's kernel, the one users tune.
+  const estimate::MapKernel& kc = k[MapKind::Caustic];
+  sc["kernel.radius"] = double(timeDependent ? kc.radius : kc.spatialRadius);
+  sc["kernel.spatial_radius"] = double(kc.spatialRadius);
+  sc["kernel.half_window"] = timeDependent ? double(kc.halfWindow) : 0.0;
   sc["seconds"] = scalarOr(state, "seconds", 0) + f.seconds;
   return overflow;
 }
@@ -465,8 +472,8 @@ PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& o
   // fallback 2/3; the other variants have only the spatial kernel (d = 2).
   const double s3 = kernelScale(pass, alpha, 3);
   const double s2 = kernelScale(pass, time ? kAlphaSpatial : alpha, 2);
-  auto one = [&](const char* map) {
-    std::string p = std::string("kernel.") + map + ".";
+  auto one = [&](MapKind kind) {
+    std::string p = std::string("kernel.") + mapKindName(kind) + ".";
     estimate::MapKernel k;
     double r1 = scalarOr(state, p + "radius_1", 0), h1 = scalarOr(state, p + "half_window_1", 0);
     double r = r1 * s3, h = h1 * s3;
@@ -481,7 +488,9 @@ PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& o
     k.spatialRadius = float(scalarOr(state, p + "spatial_radius_1", 0) * s2);
     return k;
   };
-  return {one("caustic"), one("global")};
+  PassKernels all;
+  for (MapKind kind : kAllMapKinds) all[kind] = one(kind);
+  return all;
 }
 
 void runProgressivePass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
@@ -549,13 +558,12 @@ void prepareState(ProgressiveState& state, const RenderOptions& opt, int w, int 
                       {"seed", std::to_string(opt.seed)},
                       {"sampler", samplerName(opt.sampler)},
                       {"spp", std::to_string(opt.spp)},
-                      {"photons", std::to_string(opt.causticPhotons)},
-                      {"global_photons", std::to_string(opt.globalPhotons)},
                       {"alpha", a},
                       {"max_depth", std::to_string(opt.maxDepth)},
                       {"gather", std::to_string(opt.gatherRays)},
                       {"k", std::to_string(opt.estimate.k)},
                       {"resolution", std::to_string(w) + "x" + std::to_string(h)}};
+    for (MapKind k : kAllMapKinds) state.settings[mapKindInfo(k).optionName] = std::to_string(opt.*mapKindInfo(k).photons);
   }
 }
 
