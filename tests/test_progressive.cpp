@@ -303,12 +303,13 @@ TEST_CASE("progressive: a pass's photon paths continue the path indices of the p
 TEST_CASE("progressive: pass kernels follow alpha, and the half window stops at one time bin keeping the volume") {
   auto s = Scene::build(movingPlane(8));  // shutter [0, 1]: one bin is 1/256 s
   ProgressiveState st;
-  st.scalars["kernel.caustic.radius_1"] = 0.1;
-  st.scalars["kernel.caustic.half_window_1"] = 0.05;
-  st.scalars["kernel.caustic.spatial_radius_1"] = 0.2;
-  st.scalars["kernel.global.radius_1"] = 0.1;
-  st.scalars["kernel.global.half_window_1"] = 1.1 / 256.0;  // 1.1 bins
-  st.scalars["kernel.global.spatial_radius_1"] = 0.2;
+  st.pilot.done = true;
+  st.pilot.maps[MapKind::Caustic].radius = 0.1;
+  st.pilot.maps[MapKind::Caustic].halfWindow = 0.05;
+  st.pilot.maps[MapKind::Caustic].spatialRadius = 0.2;
+  st.pilot.maps[MapKind::Global].radius = 0.1;
+  st.pilot.maps[MapKind::Global].halfWindow = 1.1 / 256.0;  // 1.1 bins
+  st.pilot.maps[MapKind::Global].spatialRadius = 0.2;
   RenderOptions o;
   o.method = RenderMethod::Time;
   for (float alpha : {0.0f, 0.5f}) {

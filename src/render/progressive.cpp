@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <cfloat>
 #include <cmath>
 #include <csignal>
@@ -55,11 +56,6 @@ double shutterOf(const Scene& scene, const RenderOptions& opt) {
   float t0, t1;
   photon::photonTimeRange(scene, t0, t1);
   return double(t1) - double(t0);
-}
-
-double scalarOr(const ProgressiveState& s, const std::string& key, double fallback) {
-  auto it = s.scalars.find(key);
-  return it == s.scalars.end() ? fallback : it->second;
 }
 
 double median(std::vector<double>& v) {
@@ -127,14 +123,10 @@ estimate::MapKernel pilotKernel(const PhotonMap* map, const Scene& scene, const 
   return k;
 }
 
-// The state's names of a map's pass-0 values.
-std::string pathsKey(MapKind kind) { return std::string("photons.") + mapKindName(kind) + "_paths_per_pass"; }
-
-void storeKernel(ProgressiveState& st, MapKind kind, const estimate::MapKernel& k) {
-  std::string p = std::string("kernel.") + mapKindName(kind) + ".";
-  st.scalars[p + "radius_1"] = double(k.radius);
-  st.scalars[p + "half_window_1"] = double(k.halfWindow);
-  st.scalars[p + "spatial_radius_1"] = double(k.spatialRadius);
+void storeKernel(ProgressiveMapPilot& pilot, const estimate::MapKernel& k) {
+  pilot.radius = double(k.radius);
+  pilot.halfWindow = double(k.halfWindow);
+  pilot.spatialRadius = double(k.spatialRadius);
 }
 
 float mainAlpha(const RenderOptions& opt) {
@@ -244,30 +236,25 @@ struct PassFigures {
   }
 };
 
-// The scalars pass 0 fixes for every later pass (paths per pass from the
-// tracer's pilot, pass 1's kernels from the k-NN pilot): what the other
-// ranks need before their first pass.
-const char* const kPilotScalars[] = {"photons.caustic_paths_per_pass",  "photons.global_paths_per_pass",
-                                     "kernel.caustic.radius_1",         "kernel.caustic.half_window_1",
-                                     "kernel.caustic.spatial_radius_1", "kernel.global.radius_1",
-                                     "kernel.global.half_window_1",     "kernel.global.spatial_radius_1"};
-constexpr size_t kPilotCount = sizeof kPilotScalars / sizeof kPilotScalars[0];
-
-bool hasPilot(const ProgressiveState& s) { return s.scalars.count("kernel.caustic.radius_1") > 0; }
-
-// Rank 0's pilot scalars into every rank's state (collective).
-// Rank 0 sends its pilot values; `valid` false (rank 0's pass 0 was
-// cancelled before its pilot ended) tells the others there are none, and
-// they return false without touching their state.
+// Rank 0's pilot values (render/progressive_state.h ProgressivePilot:
+// what pass 0 fixes for every later pass) into every rank's state
+// (collective). `valid` false (rank 0's pass 0 was cancelled before its
+// pilot ended) tells the others there are none, and they return false
+// without touching their state.
 bool sharePilot(dist::Comm& comm, ProgressiveState& s, bool valid = true) {
-  double v[kPilotCount + 1] = {};
+  constexpr size_t kPerMap = 4;
+  double v[kPerMap * kMapKinds + 1] = {};
+  auto fields = [](ProgressiveMapPilot& m) { return std::array<double*, kPerMap>{&m.pathsPerPass, &m.radius, &m.halfWindow, &m.spatialRadius}; };
   if (comm.root()) {
-    for (size_t i = 0; i < kPilotCount; ++i) v[i] = scalarOr(s, kPilotScalars[i], 0);
-    v[kPilotCount] = valid ? 1.0 : 0.0;
+    for (MapKind k : kAllMapKinds)
+      for (size_t i = 0; i < kPerMap; ++i) v[kPerMap * size_t(k) + i] = *fields(s.pilot.maps[k])[i];
+    v[kPerMap * kMapKinds] = valid ? 1.0 : 0.0;
   }
   comm.broadcast(v, sizeof v, 0);
-  if (v[kPilotCount] == 0.0) return false;
-  for (size_t i = 0; i < kPilotCount; ++i) s.scalars[kPilotScalars[i]] = v[i];
+  if (v[kPerMap * kMapKinds] == 0.0) return false;
+  for (MapKind k : kAllMapKinds)
+    for (size_t i = 0; i < kPerMap; ++i) *fields(s.pilot.maps[k])[i] = v[kPerMap * size_t(k) + i];
+  s.pilot.done = true;
   return true;
 }
 
@@ -299,7 +286,7 @@ Progress cancellable(const Progress& progress) {
 }
 
 // Renders pass `pass` into `mean` (3 floats a pixel) without touching the
-// sums. Reads the pilot scalars from `state`, or (pass 0 of a new render)
+// sums. Reads the pilot values from `state`, or (pass 0 of a new render)
 // computes them into it and then calls `afterPilot` (may be empty). Only
 // warnings go to `st`; the rest is in the figures, for addPass.
 PassFigures computePass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state, int pass,
@@ -321,11 +308,10 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
       ts.timeOpen = opt.frameOpen;
       ts.timeClose = opt.frameClose;
     }
-    auto it = state.scalars.find(pathsKey(kind));
-    if (it == state.scalars.end()) continue;
+    if (!state.pilot.done) continue;  // pass 0: the tracer's pilot sizes the emission
     // A resumed value was checked (render/progressive_check.h): a whole
     // number of batches, small enough for every pass index.
-    uint64_t paths = uint64_t(it->second);
+    uint64_t paths = uint64_t(state.pilot.maps[kind].pathsPerPass);
     if (paths == 0) ts.storedWanted = 0;
     ts.paths = paths;
     TDPM_ASSERT(paths == 0 || uint64_t(pass) + 1 <= UINT64_MAX / paths, "progressive photon path index overflows");
@@ -335,15 +321,16 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
   double photonSeconds = 0;
   for (MapKind kind : kAllMapKinds) {
     const PhotonMap& m = *maps[kind];
-    if (!state.scalars.count(pathsKey(kind))) state.scalars[pathsKey(kind)] = double(m.emitted);
+    if (!state.pilot.done) state.pilot.maps[kind].pathsPerPass = double(m.emitted);
     photonSeconds += m.traceSeconds + m.buildSeconds;
     if (!m.warning.empty() && pass == 0) st.warnings.push_back(m.warning);
   }
 
   // ---- kernels: pass 1's from a k-NN pilot on pass 0's maps ----
   const bool timeDependent = renderMethodTraits(opt.method).timeDependentEstimate && scene.hasMotion;
-  if (!hasPilot(state)) {
-    for (MapKind kind : kAllMapKinds) storeKernel(state, kind, pilotKernel(maps[kind], scene, opt, timeDependent));
+  if (!state.pilot.done) {
+    for (MapKind kind : kAllMapKinds) storeKernel(state.pilot.maps[kind], pilotKernel(maps[kind], scene, opt, timeDependent));
+    state.pilot.done = true;
     if (afterPilot) afterPilot();
   }
   PassKernels k = kernelsForPass(state, opt, scene, pass);
@@ -432,15 +419,15 @@ std::string addPass(const Scene& scene, const RenderOptions& opt, ProgressiveSta
   const bool timeDependent = renderMethodTraits(opt.method).timeDependentEstimate && scene.hasMotion;
   PassKernels k = kernelsForPass(state, opt, scene, pass);
   state.passesDone = pass + 1;
-  auto& sc = state.scalars;
-  sc["photons.emitted"] = scalarOr(state, "photons.emitted", 0) + emitted;
-  sc["photons.stored"] = scalarOr(state, "photons.stored", 0) + stored;
+  ProgressiveTotals& t = state.totals;
+  t.photonsEmitted += emitted;
+  t.photonsStored += stored;
   // Reported (not read back): the caustic map's kernel, the one users tune.
   const estimate::MapKernel& kc = k[MapKind::Caustic];
-  sc["kernel.radius"] = double(timeDependent ? kc.radius : kc.spatialRadius);
-  sc["kernel.spatial_radius"] = double(kc.spatialRadius);
-  sc["kernel.half_window"] = timeDependent ? double(kc.halfWindow) : 0.0;
-  sc["seconds"] = scalarOr(state, "seconds", 0) + f.seconds;
+  t.kernelRadius = double(timeDependent ? kc.radius : kc.spatialRadius);
+  t.kernelSpatialRadius = double(kc.spatialRadius);
+  t.kernelHalfWindow = timeDependent ? double(kc.halfWindow) : 0.0;
+  t.seconds += f.seconds;
   return overflow;
 }
 
@@ -473,9 +460,9 @@ PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& o
   const double s3 = kernelScale(pass, alpha, 3);
   const double s2 = kernelScale(pass, time ? kAlphaSpatial : alpha, 2);
   auto one = [&](MapKind kind) {
-    std::string p = std::string("kernel.") + mapKindName(kind) + ".";
+    const ProgressiveMapPilot& pilot = state.pilot.maps[kind];
     estimate::MapKernel k;
-    double r1 = scalarOr(state, p + "radius_1", 0), h1 = scalarOr(state, p + "half_window_1", 0);
+    double r1 = pilot.radius, h1 = pilot.halfWindow;
     double r = r1 * s3, h = h1 * s3;
     if (h < binWidth && h1 > 0) {
       // Below one time bin the window cannot resolve more (photon/store.h):
@@ -485,7 +472,7 @@ PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& o
     }
     k.radius = float(r);
     k.halfWindow = float(h);
-    k.spatialRadius = float(scalarOr(state, p + "spatial_radius_1", 0) * s2);
+    k.spatialRadius = float(pilot.spatialRadius * s2);
     return k;
   };
   PassKernels all;
@@ -532,7 +519,7 @@ namespace {
 // Where the pass loop stands, for the progress bar and pass lines.
 WorkPosition passPosition(const ProgressiveState& state, const RenderOptions& opt, double limit) {
   return WorkPosition{"pass", size_t(state.passesDone), size_t(std::max(0, opt.passes)), limit,
-                      uint64_t(scalarOr(state, "photons.emitted", 0))};
+                      uint64_t(state.totals.photonsEmitted)};
 }
 
 // A new state gets its zero layers and its settings; a resumed one is
@@ -541,7 +528,8 @@ void prepareState(ProgressiveState& state, const RenderOptions& opt, int w, int 
   const size_t n = size_t(w) * size_t(h);
   if (state.empty()) {
     state.layers.clear();
-    state.scalars.clear();
+    state.pilot = {};
+    state.totals = {};
   }
   for (const char* name : kLayers) {
     if (!comm.root()) break;  // the sums live on rank 0 only
@@ -598,7 +586,7 @@ bool runDistributedRounds(const Scene& scene, const RenderOptions& opt, Progress
         std::min(opt.passes > 0 ? std::min(N, opt.passes - first) : N, maxProgressivePasses() - first);
     if (inRound <= 0) break;
     const bool has = rank < inRound;
-    const bool needPilot = !hasPilot(state);
+    const bool needPilot = !state.pilot.done;
     bool cancelled = false, pilotSent = false;
     if (needPilot && !comm.root()) cancelled = !sharePilot(comm, state);
     std::vector<float> mean;

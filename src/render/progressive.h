@@ -51,7 +51,7 @@ using PassKernels = PerMap<estimate::MapKernel>;
 // (j 1-based): (V_{pass+1} / V_1)^(1/dims). Deterministic (a double product).
 double kernelScale(int pass, double alpha, int dims);
 
-// The kernels of pass `pass` from pass 0's (state.scalars "kernel.*_1"),
+// The kernels of pass `pass` from pass 0's (state.pilot),
 // with the half window floored at one photon time bin (shutter / 256; the
 // volume schedule is then kept by the radius).
 PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& opt, const Scene& scene, int pass);
