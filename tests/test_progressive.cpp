@@ -278,10 +278,10 @@ TEST_CASE("progressive: a pass's photon paths continue the path indices of the p
   t.seed = 4;
   const uint64_t P = 4 * photon::kPathsPerBatch;
   auto trace = [&](uint64_t first, uint64_t paths) {
-    photon::TraceSettings u = t;
-    u.firstPath = first;
-    u.paths = paths;
-    return photon::tracePhotons(*s, u, Progress{});
+    photon::PathRange range;
+    range.firstPath = first;
+    range.paths = paths;
+    return photon::tracePassPhotons(*s, t, range, Progress{});
   };
   photon::TraceResult whole = trace(0, 2 * P), a = trace(0, P), b = trace(P, P);
   CHECK(whole.emitted == 2 * P);

@@ -295,10 +295,11 @@ class SegmentTimeline {
                            hashCombine(opt_.seed, key, uint64_t(hi - lo)));
       ts.timeOpen = float(double(lo) * grid_.binWidth);
       ts.timeClose = float(double(hi) * grid_.binWidth);
-      ts.storeT0 = ts.timeOpen;
-      ts.storeT1 = float(double(lo + photon::kTimeBins) * grid_.binWidth);
-      ts.storedPerPath = rate;
-      photon::TraceResult r = photon::tracePhotons(scene_, ts, framed_);
+      photon::SegmentStore grid;  // the timeline's bins, and the period's measured rate
+      grid.storeT0 = ts.timeOpen;
+      grid.storeT1 = float(double(lo + photon::kTimeBins) * grid_.binWidth);
+      grid.storedPerPath = rate;
+      photon::TraceResult r = photon::traceSegmentPhotons(scene_, ts, grid, framed_);
       addWarning(stats_, r.warning);
       emitted_ += r.emitted;
       stats_.maps[kind].stored += r.store.size();

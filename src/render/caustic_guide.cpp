@@ -91,11 +91,9 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
   t.storedWanted = s.photons;
   t.seed = hashCombine(s.seed, 0x6775696465ull);  // "guide": apart from the render's own streams
   t.sampler = s.sampler;
-  t.areaLightsOnly = true;
-  t.keepExitPoints = true;
   t.glossyCaustics = false;  // cones aim at delta exit points only
   t.comm = &dist::local();  // every rank traces the same guide itself
-  photon::TraceResult traced = photon::tracePhotons(scene, t, progress);
+  photon::TraceResult traced = photon::traceGuidePhotons(scene, t, progress);  // area lights, exit points kept
   if (traced.store.size() < size_t(kNeighbours) || traced.exitPoints.size() != traced.store.size()) return g;
 
   g.emitted_ = traced.emitted;

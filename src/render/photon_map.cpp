@@ -46,7 +46,7 @@ double PhotonMap::bytesPerPhoton() const {
 std::unique_ptr<PhotonMap> buildPhotonMap(const Scene& scene, const PhotonMapSettings& settings,
                                           const Progress& progress) {
   auto map = std::make_unique<PhotonMap>();
-  photon::TraceResult traced = photon::tracePhotons(scene, settings.trace, progress);
+  photon::TraceResult traced = photon::tracePassPhotons(scene, settings.trace, settings.pass, progress);
   map->store = std::move(traced.store);
   map->emitted = traced.emitted;
   map->traceSeconds = traced.seconds;

@@ -34,6 +34,7 @@ struct PhotonMap {
 
 struct PhotonMapSettings {
   photon::TraceSettings trace;
+  photon::PathRange pass;  // a progressive pass's paths; pass.paths 0: sized by the tracer's pilot
   bool spaceTime = false;  // build the 4D tree (plus a 3D copy)
   float kappa = 1.0f;
 };

@@ -313,9 +313,9 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
     // number of batches, small enough for every pass index.
     uint64_t paths = uint64_t(state.pilot.maps[kind].pathsPerPass);
     if (paths == 0) ts.storedWanted = 0;
-    ts.paths = paths;
+    settings[kind].pass.paths = paths;
     TDPM_ASSERT(paths == 0 || uint64_t(pass) + 1 <= UINT64_MAX / paths, "progressive photon path index overflows");
-    ts.firstPath = uint64_t(pass) * paths;
+    settings[kind].pass.firstPath = uint64_t(pass) * paths;
   }
   PhotonMaps maps = buildPhotonMaps(scene, settings, progress);
   double photonSeconds = 0;
