@@ -1,5 +1,5 @@
 // tests/progressive_checks.h — the bit-identity checks progressive suites
-// share: two states equal bit for bit (layers and scalars, but wall-clock
+// share: two states equal bit for bit (layers, pilot and totals, but wall-clock
 // seconds), and a render of 4 passes equal to 2 + 2 resumed and to the same
 // render on one thread.
 #pragma once
@@ -15,10 +15,13 @@
 namespace tdpm::test {
 
 inline bool sameState(const ProgressiveState& a, const ProgressiveState& b) {
-  auto sa = a.scalars, sb = b.scalars;
-  sa.erase("seconds");
-  sb.erase("seconds");
-  if (a.passesDone != b.passesDone || sa != sb || a.layers.size() != b.layers.size()) return false;
+  ProgressiveTotals ta = a.totals, tb = b.totals;
+  ta.seconds = tb.seconds = 0;  // wall clock
+  const bool sameTotals = ta.photonsEmitted == tb.photonsEmitted && ta.photonsStored == tb.photonsStored &&
+                          ta.kernelRadius == tb.kernelRadius && ta.kernelSpatialRadius == tb.kernelSpatialRadius &&
+                          ta.kernelHalfWindow == tb.kernelHalfWindow;
+  if (a.passesDone != b.passesDone || !(a.pilot == b.pilot) || !sameTotals || a.layers.size() != b.layers.size())
+    return false;
   for (const auto& [name, l] : a.layers) {
     auto it = b.layers.find(name);
     if (it == b.layers.end() || it->second.size() != l.size()) return false;

@@ -16,6 +16,7 @@
 #include "core/rng.h"
 #include "photon/kdtree.h"
 #include "photon/store.h"
+#include "render/memory_budget.h"
 #include "render/renderer.h"
 
 using namespace tdpm;
@@ -147,26 +148,26 @@ TEST_CASE("memory: the pre-flight photon estimate and its error") {
   // 3D caustic only: tracing holds the store and its shrink-to-fit copy
   // (2 x 20 bytes) plus one chunk of batch buffers (40 bytes a photon, one
   // photon a caustic path); just above the kd-tree build's 20 + 21.
-  CHECK(photonMemoryBytes(n, 0, false, 16) == n * 40 + chunkPaths * 40);
+  CHECK(photonMemoryBytes({n, 0}, false, 16) == n * 40 + chunkPaths * 40);
   // 4D: the 3D copy is held while the 4D tree is built: 2 x 20 + 25.
-  CHECK(photonMemoryBytes(n, 0, true, 16) == n * 65);
+  CHECK(photonMemoryBytes({n, 0}, true, 16) == n * 65);
   // The global map is traced while the caustic map is held; a global path
   // stores up to max_depth + 1 photons, so its chunk is 17 times larger.
-  CHECK(photonMemoryBytes(n, n, false, 16) == n * 20 + n * 40 + chunkPaths * 17 * 40);
-  CHECK(photonMemoryBytes(n, n, true, 16) == n * 40 + n * 65);
+  CHECK(photonMemoryBytes({n, n}, false, 16) == n * 20 + n * 40 + chunkPaths * 17 * 40);
+  CHECK(photonMemoryBytes({n, n}, true, 16) == n * 40 + n * 65);
   // No photons: nothing (the pilot only runs for a map that is traced).
-  CHECK(photonMemoryBytes(0, 0, false, 16) == 0);
+  CHECK(photonMemoryBytes({0, 0}, false, 16) == 0);
   // A tiny global map still pays for the pilot (16K paths, up to 17 photons each).
-  CHECK(photonMemoryBytes(0, 1, false, 16) == uint64_t(16 * 1024) * 17 * 60);
+  CHECK(photonMemoryBytes({0, 1}, false, 16) == uint64_t(16 * 1024) * 17 * 60);
 
   const uint64_t avail = uint64_t(8) << 30;  // 8 GiB
-  CHECK_NOTHROW(checkPhotonMemory(n, n, true, 16, avail, "--photons", "--global-photons"));
+  CHECK_NOTHROW(checkPhotonMemory({n, n}, true, 16, avail, {"--photons", "--global-photons"}));
   // Unknown availability (no /proc): never refuse.
-  CHECK_NOTHROW(checkPhotonMemory(size_t(1) << 31, size_t(1) << 31, true, 16, 0, "--photons", "--global-photons"));
+  CHECK_NOTHROW(checkPhotonMemory({size_t(1) << 31, size_t(1) << 31}, true, 16, 0, {"--photons", "--global-photons"}));
 
   auto message = [&](size_t c, size_t g, bool st) {
     try {
-      checkPhotonMemory(c, g, st, 16, avail, "--photons", "render.global_photons in s.json");
+      checkPhotonMemory({c, g}, st, 16, avail, {"--photons", "render.global_photons in s.json"});
     } catch (const Error& e) {
       return std::string(e.what());
     }
@@ -222,7 +223,7 @@ TEST_CASE("memory: peak resident memory of a 10M-caustic-photon render stays wit
   CHECK(peak <= budget);
   // The pre-flight estimate the renderer checks against MemAvailable is an
   // upper bound of what the photon pass really took (up to the base slack).
-  CHECK(peak <= basePeak + kBaseSlack + photonMemoryBytes(stored, 0, false, 16));
+  CHECK(peak <= basePeak + kBaseSlack + photonMemoryBytes({stored, 0}, false, 16));
 }
 
 TEST_CASE("memory: a photon budget that cannot fit fails before any work, with the flag and the bytes") {

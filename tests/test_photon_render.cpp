@@ -90,7 +90,7 @@ TEST_CASE("moving plane: the standard estimate falls short by the factor the geo
   // mid-shutter, d = 2.5).
   double v = 1.0, ts = 1.0;
   double E = kIntensity / (2.5 * 2.5);
-  double Q = 4 * kPi * kIntensity * ts / double(r.stats.globalEmitted);
+  double Q = 4 * kPi * kIntensity * ts / double(r.stats.maps[MapKind::Global].emitted);
   double N = E / Q;
   double radius = std::cbrt(3.0 * 100 * v / (4 * kPi * N));
   double predicted = 4.0 / 3.0 * radius / (v * ts);
@@ -152,7 +152,7 @@ TEST_CASE("static scene: time and standard give identical images and no temporal
   CHECK(bitIdentical(a, b));
   CHECK(stTime.timeEstimates == 0);
   CHECK(stTime.standardEstimates > 0);
-  CHECK(stTime.causticStored > 10000);  // the comparison is between lit images
+  CHECK(stTime.maps[MapKind::Caustic].stored > 10000);  // the comparison is between lit images
   double sum = 0;
   for (Rgb c : a.color) sum += c.average();
   CHECK(sum > 0);
@@ -238,7 +238,7 @@ TEST_CASE("determinism: every method gives bit-identical images on 1 and 2 threa
       Film b = renderWith(d, o, s2, 2);
       INFO(method << (fourD ? " (4d)" : ""));
       CHECK(bitIdentical(a, b));
-      CHECK(s1.causticStored == s2.causticStored);
+      CHECK(s1.maps[MapKind::Caustic].stored == s2.maps[MapKind::Caustic].stored);
     }
   }
 }

@@ -278,10 +278,10 @@ TEST_CASE("progressive: a pass's photon paths continue the path indices of the p
   t.seed = 4;
   const uint64_t P = 4 * photon::kPathsPerBatch;
   auto trace = [&](uint64_t first, uint64_t paths) {
-    photon::TraceSettings u = t;
-    u.firstPath = first;
-    u.paths = paths;
-    return photon::tracePhotons(*s, u, Progress{});
+    photon::PathRange range;
+    range.firstPath = first;
+    range.paths = paths;
+    return photon::tracePassPhotons(*s, t, range, Progress{});
   };
   photon::TraceResult whole = trace(0, 2 * P), a = trace(0, P), b = trace(P, P);
   CHECK(whole.emitted == 2 * P);
@@ -303,29 +303,30 @@ TEST_CASE("progressive: a pass's photon paths continue the path indices of the p
 TEST_CASE("progressive: pass kernels follow alpha, and the half window stops at one time bin keeping the volume") {
   auto s = Scene::build(movingPlane(8));  // shutter [0, 1]: one bin is 1/256 s
   ProgressiveState st;
-  st.scalars["kernel.caustic.radius_1"] = 0.1;
-  st.scalars["kernel.caustic.half_window_1"] = 0.05;
-  st.scalars["kernel.caustic.spatial_radius_1"] = 0.2;
-  st.scalars["kernel.global.radius_1"] = 0.1;
-  st.scalars["kernel.global.half_window_1"] = 1.1 / 256.0;  // 1.1 bins
-  st.scalars["kernel.global.spatial_radius_1"] = 0.2;
+  st.pilot.done = true;
+  st.pilot.maps[MapKind::Caustic].radius = 0.1;
+  st.pilot.maps[MapKind::Caustic].halfWindow = 0.05;
+  st.pilot.maps[MapKind::Caustic].spatialRadius = 0.2;
+  st.pilot.maps[MapKind::Global].radius = 0.1;
+  st.pilot.maps[MapKind::Global].halfWindow = 1.1 / 256.0;  // 1.1 bins
+  st.pilot.maps[MapKind::Global].spatialRadius = 0.2;
   RenderOptions o;
   o.method = RenderMethod::Time;
   for (float alpha : {0.0f, 0.5f}) {
     o.alpha = alpha;
     double a3 = alpha > 0 ? alpha : 4.0 / 7.0;
     PassKernels k = kernelsForPass(st, o, *s, 9);
-    CHECK(k.caustic.radius == doctest::Approx(0.1 * kernelScale(9, a3, 3)));
-    CHECK(k.caustic.halfWindow == doctest::Approx(0.05 * kernelScale(9, a3, 3)));
-    CHECK(k.caustic.spatialRadius == doctest::Approx(0.2 * kernelScale(9, 2.0 / 3.0, 2)));  // time's fallback: 2/3
+    CHECK(k[MapKind::Caustic].radius == doctest::Approx(0.1 * kernelScale(9, a3, 3)));
+    CHECK(k[MapKind::Caustic].halfWindow == doctest::Approx(0.05 * kernelScale(9, a3, 3)));
+    CHECK(k[MapKind::Caustic].spatialRadius == doctest::Approx(0.2 * kernelScale(9, 2.0 / 3.0, 2)));  // time's fallback: 2/3
     // The global window would fall below a bin: floored there, r^2 h keeps the schedule.
     double s3 = kernelScale(9, a3, 3);
     CHECK(1.1 * s3 < 1.0);
-    CHECK(k.global.halfWindow == doctest::Approx(1.0 / 256.0));
-    CHECK(double(k.global.radius) * k.global.radius * k.global.halfWindow ==
+    CHECK(k[MapKind::Global].halfWindow == doctest::Approx(1.0 / 256.0));
+    CHECK(double(k[MapKind::Global].radius) * k[MapKind::Global].radius * k[MapKind::Global].halfWindow ==
           doctest::Approx(0.01 * s3 * s3 * (1.1 / 256.0) * s3).epsilon(1e-4));
   }
   o.method = RenderMethod::Standard;
   o.alpha = 0.5f;
-  CHECK(kernelsForPass(st, o, *s, 9).caustic.spatialRadius == doctest::Approx(0.2 * kernelScale(9, 0.5, 2)));
+  CHECK(kernelsForPass(st, o, *s, 9)[MapKind::Caustic].spatialRadius == doctest::Approx(0.2 * kernelScale(9, 0.5, 2)));
 }

@@ -63,9 +63,14 @@ ProgressiveState sampleState(int w, int h) {
   s.passesDone = 37;
   s.settings = {{"method", "time"}, {"photons", "100000"}, {"alpha", "0.7"}, {"resolution", "5x3"},
                 {"note", "spaces, commas = and / are fine"}};
-  for (size_t i = 0; i < sizeof kAwkward / sizeof kAwkward[0]; ++i) s.scalars["v" + std::to_string(i)] = kAwkward[i];
-  s.scalars["photons.emitted"] = 123456789012.0;
-  s.scalars["nan"] = std::numeric_limits<double>::quiet_NaN();
+  // Every scalar of the table an awkward double (the state is ours: its
+  // fields may be written through the table's pointers).
+  s.pilot.done = true;
+  size_t i = 0;
+  const size_t awkward = sizeof kAwkward / sizeof kAwkward[0];
+  for (const ProgressiveScalar& sc : progressiveScalars(s)) *const_cast<double*>(sc.value) = kAwkward[i++ % awkward];
+  s.totals.photonsEmitted = 123456789012.0;
+  s.totals.kernelHalfWindow = std::numeric_limits<double>::quiet_NaN();
   const size_t n = size_t(w) * size_t(h);
   // Floats that a conversion would change: NaN with a payload, -0, the
   // smallest subnormal, FLT_MAX, infinity, and plain values.
@@ -118,12 +123,14 @@ TEST_CASE("progressive io: a state survives an EXR file bit for bit") {
   CHECK(r->fingerprint == s.fingerprint);
   CHECK(r->passesDone == 37);
   CHECK(r->settings == s.settings);
-  REQUIRE(r->scalars.size() == s.scalars.size());
-  for (const auto& [name, v] : s.scalars) {
-    CAPTURE(name);
-    REQUIRE(r->scalars.count(name));
-    if (std::isnan(v)) CHECK(std::isnan(r->scalars.at(name)));
-    else CHECK(bitsOf(r->scalars.at(name)) == bitsOf(v));
+  CHECK(r->pilot.done);
+  const std::vector<ProgressiveScalar> want = progressiveScalars(s), got = progressiveScalars(*r);
+  REQUIRE(got.size() == want.size());
+  for (size_t j = 0; j < want.size(); ++j) {
+    CAPTURE(want[j].name);
+    CHECK(back.metadata.count("tdpm/progressive/scalar/" + want[j].name));
+    if (std::isnan(*want[j].value)) CHECK(std::isnan(*got[j].value));
+    else CHECK(bitsOf(*got[j].value) == bitsOf(*want[j].value));
   }
   REQUIRE(r->layers.size() == s.layers.size());
   for (const auto& [name, v] : s.layers) {
@@ -147,7 +154,8 @@ TEST_CASE("progressive io: adding a state replaces the old one") {
   REQUIRE(r);
   CHECK(r->passesDone == 1);
   CHECK(r->settings.empty());
-  CHECK(r->scalars.empty());
+  CHECK(!r->pilot.done);
+  for (const auto& kv : exr.metadata) CHECK(kv.first.rfind("tdpm/progressive/scalar/", 0) != 0);
   CHECK(r->layers.size() == 1);
   CHECK(!exr.findChannel("progressive.radius"));
   CHECK(exr.findChannel("spp"));  // not the state's: kept
@@ -182,6 +190,10 @@ TEST_CASE("progressive io: no state, and damaged states") {
               "attribute tdpm/progressive/fingerprint is missing");
   expectError([](image::ExrFile& e) { e.metadata["tdpm/progressive/scalar/seconds"] = "12,5"; },
               "tdpm/progressive/scalar/seconds is '12,5', not a number");
+  expectError([](image::ExrFile& e) { e.metadata.erase("tdpm/progressive/scalar/kernel.global.half_window_1"); },
+              "tdpm/progressive/scalar/kernel.global.half_window_1 is missing");
+  expectError([](image::ExrFile& e) { e.metadata["tdpm/progressive/scalar/kernel.volume.radius_1"] = "1"; },
+              "tdpm/progressive/scalar/kernel.volume.radius_1 is not a value a progressive render writes");
   expectError(
       [](image::ExrFile& e) {
         for (auto it = e.extra.begin(); it != e.extra.end(); ++it)

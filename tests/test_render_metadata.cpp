@@ -18,8 +18,8 @@ RenderStats someStats() {
   st.seconds = 1.25;
   st.minSpp = 4;
   st.maxSpp = 12;
-  st.causticStored = 1234;
-  st.globalStored = 567;
+  st.maps[MapKind::Caustic].stored = 1234;
+  st.maps[MapKind::Global].stored = 567;
   return st;
 }
 

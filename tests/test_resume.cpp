@@ -47,15 +47,17 @@ struct Setup {
   static void fill(ProgressiveState& st, const RenderOptions& o, size_t n, int passes) {
     st.passesDone = passes;
     const double p = passes;
-    st.scalars["photons.caustic_paths_per_pass"] = 10 * 1024;
-    st.scalars["photons.global_paths_per_pass"] = 2 * 1024;
-    st.scalars["photons.emitted"] = p * 12 * 1024;
-    st.scalars["photons.stored"] = p * 3000;
-    st.scalars["seconds"] = 1.5;
-    for (const char* k : {"kernel.caustic.radius_1", "kernel.caustic.half_window_1", "kernel.caustic.spatial_radius_1",
-                          "kernel.global.radius_1", "kernel.global.half_window_1", "kernel.global.spatial_radius_1"})
-      st.scalars[k] = 0.125;
-    for (const char* k : {"kernel.radius", "kernel.spatial_radius", "kernel.half_window"}) st.scalars[k] = 0.0625;
+    st.pilot.done = true;
+    st.pilot.maps[MapKind::Caustic].pathsPerPass = 10 * 1024;
+    st.pilot.maps[MapKind::Global].pathsPerPass = 2 * 1024;
+    for (MapKind k : kAllMapKinds) {
+      ProgressiveMapPilot& m = st.pilot.maps[k];
+      m.radius = m.halfWindow = m.spatialRadius = 0.125;
+    }
+    st.totals.photonsEmitted = p * 12 * 1024;
+    st.totals.photonsStored = p * 3000;
+    st.totals.seconds = 1.5;
+    st.totals.kernelRadius = st.totals.kernelSpatialRadius = st.totals.kernelHalfWindow = 0.0625;
     for (const char* name : {"sum.R", "sum.G", "sum.B"}) st.layers[name] = std::vector<float>(n, 0.25f * float(p));
     for (const char* name : {"sumsq.R", "sumsq.G", "sumsq.B"})
       st.layers[name] = std::vector<float>(n, 0.0625f * float(p));
@@ -91,7 +93,10 @@ TEST_CASE("resume: the state of the same render is accepted, exactly") {
   CHECK(back.passesDone == 4);
   CHECK(back.fingerprint == st.fingerprint);
   CHECK(back.settings == st.settings);
-  CHECK(back.scalars == st.scalars);
+  CHECK(back.pilot == st.pilot);
+  CHECK(back.totals.photonsEmitted == st.totals.photonsEmitted);
+  CHECK(back.totals.seconds == st.totals.seconds);
+  CHECK(back.totals.kernelHalfWindow == st.totals.kernelHalfWindow);
   CHECK(back.layers == st.layers);
 }
 
@@ -238,7 +243,7 @@ TEST_CASE("resume: a long state's spp layer is checked against the float sums th
   std::string path = s.write("long.exr", &st, 8, 6);
   CHECK(s.errorOf(path).empty());
   st.passesDone = passes / 2;
-  st.scalars["photons.emitted"] = double(passes / 2) * 12 * 1024;
+  st.totals.photonsEmitted = double(passes / 2) * 12 * 1024;
   path = s.write("halved.exr", &st, 8, 6);
   CHECK(s.errorOf(path).find("damaged progressive state: " + path + ": layer progressive.spp is ") == 0);
 }

@@ -312,14 +312,14 @@ TEST_CASE("sparse estimates: cube-caustic with 500 global photons, 4D agrees wit
 TEST_CASE("sparse estimates: --stats counts the estimates from few photons, per map") {
   RenderStats st;
   cubeMean(false, 100, 1, &st);
-  CHECK(st.causticEstimates + st.globalEstimates == st.standardEstimates + st.timeEstimates);
-  CHECK(st.globalEstimates > 0);
-  CHECK(st.fewGlobalEstimates > st.globalEstimates / 2);
-  CHECK(st.fewCausticEstimates <= st.causticEstimates);
+  CHECK(st.maps[MapKind::Caustic].estimates + st.maps[MapKind::Global].estimates == st.standardEstimates + st.timeEstimates);
+  CHECK(st.maps[MapKind::Global].estimates > 0);
+  CHECK(st.maps[MapKind::Global].fewEstimates > st.maps[MapKind::Global].estimates / 2);
+  CHECK(st.maps[MapKind::Caustic].fewEstimates <= st.maps[MapKind::Caustic].estimates);
   cubeMean(false, 100, 1, &st, 1e6f);
-  CHECK(st.globalEstimates > 0);
-  CHECK(st.fewGlobalEstimates == 0);
-  CHECK(st.fewCausticEstimates == 0);
+  CHECK(st.maps[MapKind::Global].estimates > 0);
+  CHECK(st.maps[MapKind::Global].fewEstimates == 0);
+  CHECK(st.maps[MapKind::Caustic].fewEstimates == 0);
 }
 
 namespace {

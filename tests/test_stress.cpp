@@ -240,7 +240,7 @@ void checkExtremeScene(const std::string& what, const scene::SceneDescription& d
   PhotonIntegratorSettings is;
   is.timeDependent = scene->hasMotion;
   is.estimate.maxRadius = scene->bounds.empty() ? 1.0f : 0.02f * length(scene->bounds.diagonal());
-  PhotonIntegrator integ(*scene, caustic.get(), global.get(), is);
+  PhotonIntegrator integ(*scene, {caustic.get(), global.get()}, is);
   raw = rawSamples(*scene, integ, 4, 98);
   CHECK(raw.nan == 0);
   if (!eo.allowInfiniteSamples) CHECK(raw.inf == 0);
@@ -485,7 +485,7 @@ TEST_CASE("stress: a zero-length shutter with the time method") {
   RenderStats st;
   Film f = render(*s, o, Progress{}, st);
   CHECK(checkFilm(f).ok());
-  CHECK(st.causticStored > 0);
+  CHECK(st.maps[MapKind::Caustic].stored > 0);
 }
 
 TEST_CASE("stress: motion much larger than the scene") {

@@ -230,13 +230,15 @@ void printAnimationSummary(const RenderArgs& a, const RenderOptions& opt, const 
       std::fprintf(stderr, "tdpm: frame %d: %.2f s, %d-%d samples per pixel -> %s\n", l.frame, l.seconds, l.minSpp,
                    l.maxSpp, f.outputs[size_t(l.frame - f.range.first)].c_str());
     double all = allSeconds;
+    std::string storedText;  // "N caustic, M global"
+    for (MapKind k : kAllMapKinds)
+      storedText += (storedText.empty() ? "" : ", ") + std::to_string(stats.maps[k].stored) + " " + mapKindName(k);
     std::fprintf(stderr,
-                 "tdpm: %s, %s: %d frames (%d-%d) at %dx%d, %.2f s in all, %.2f s per frame; photons: %llu caustic, "
-                 "%llu global stored in %llu %s, %.2f s%s%s\n",
+                 "tdpm: %s, %s: %d frames (%d-%d) at %dx%d, %.2f s in all, %.2f s per frame; photons: %s stored in "
+                 "%llu %s, %.2f s%s%s\n",
                  a.scene.c_str(), renderMethodName(opt.method), f.range.count(), f.range.first, f.range.last,
                  scene.camera.width(), scene.camera.height(), all, all / double(f.range.count()),
-                 static_cast<unsigned long long>(stats.causticStored),
-                 static_cast<unsigned long long>(stats.globalStored),
+                 storedText.c_str(),
                  static_cast<unsigned long long>(opt.progressive ? stats.passesDone : stats.segmentsTraced),
                  opt.progressive ? "passes" : "segments", stats.photonSeconds,
                  a.video ? " -> video " : "", a.video ? a.video->c_str() : "");

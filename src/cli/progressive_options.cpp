@@ -16,10 +16,6 @@ std::string g17(double v) {
   std::snprintf(buf, sizeof buf, "%.9g", v);
   return buf;
 }
-double scalar(const ProgressiveState& s, const char* key) {
-  auto it = s.scalars.find(key);
-  return it == s.scalars.end() ? 0.0 : it->second;
-}
 }  // namespace
 
 void addProgressiveOptions(CLI::App* c, RenderArgs& a) {
@@ -132,12 +128,12 @@ void mergeProgressiveOptions(const RenderArgs& a, const scene::RenderSettings& s
 void addProgressiveMetadata(const ProgressiveState& s, std::map<std::string, std::string>& m) {
   m["tdpm/progressive"] = "1";
   m["tdpm/passes"] = std::to_string(s.passesDone);
-  m["tdpm/photons_emitted"] = g17(scalar(s, "photons.emitted"));
-  m["tdpm/photons_stored"] = g17(scalar(s, "photons.stored"));
-  m["tdpm/kernel_radius"] = g17(scalar(s, "kernel.radius"));
-  m["tdpm/kernel_spatial_radius"] = g17(scalar(s, "kernel.spatial_radius"));
-  m["tdpm/kernel_half_window"] = g17(scalar(s, "kernel.half_window"));
-  m["tdpm/progressive_seconds"] = g17(scalar(s, "seconds"));
+  m["tdpm/photons_emitted"] = g17(s.totals.photonsEmitted);
+  m["tdpm/photons_stored"] = g17(s.totals.photonsStored);
+  m["tdpm/kernel_radius"] = g17(s.totals.kernelRadius);
+  m["tdpm/kernel_spatial_radius"] = g17(s.totals.kernelSpatialRadius);
+  m["tdpm/kernel_half_window"] = g17(s.totals.kernelHalfWindow);
+  m["tdpm/progressive_seconds"] = g17(s.totals.seconds);
   auto a = s.settings.find("alpha");
   if (a != s.settings.end()) m["tdpm/alpha"] = a->second;
 }
@@ -158,8 +154,8 @@ std::string progressiveSummary(const ProgressiveState& s) {
   std::snprintf(buf, sizeof buf,
                 "%d passes, %.4g photons emitted (%.4g stored), final kernel radius %.4g (spatial %.4g), half window "
                 "%.4g s, %.2f s of passes",
-                s.passesDone, scalar(s, "photons.emitted"), scalar(s, "photons.stored"), scalar(s, "kernel.radius"),
-                scalar(s, "kernel.spatial_radius"), scalar(s, "kernel.half_window"), scalar(s, "seconds"));
+                s.passesDone, s.totals.photonsEmitted, s.totals.photonsStored, s.totals.kernelRadius,
+                s.totals.kernelSpatialRadius, s.totals.kernelHalfWindow, s.totals.seconds);
   return buf;
 }
 

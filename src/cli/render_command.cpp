@@ -122,8 +122,9 @@ void printStats(const RenderStats& st) {
   std::fprintf(stderr, "  peak resident memory: %llu bytes (%s)\n", u(st.peakResidentBytes),
                formatMiB(st.peakResidentBytes).c_str());
   std::fprintf(stderr, "  bytes per photon: %.2f\n", st.bytesPerPhoton);
-  std::fprintf(stderr, "  caustic photons: %llu stored, %llu emitted\n", u(st.causticStored), u(st.causticEmitted));
-  std::fprintf(stderr, "  global photons: %llu stored, %llu emitted\n", u(st.globalStored), u(st.globalEmitted));
+  for (MapKind k : kAllMapKinds)
+    std::fprintf(stderr, "  %s photons: %llu stored, %llu emitted\n", mapKindName(k), u(st.maps[k].stored),
+                 u(st.maps[k].emitted));
   if (st.guideStored > 0)
     std::fprintf(stderr, "  caustic guide: %llu stored, %llu emitted, %s reserved, %.3f s; cache %llu of %llu sub-cells filled\n",
                  u(st.guideStored), u(st.guideEmitted), formatMiB(st.guideBytes).c_str(), st.guideSeconds,
@@ -133,10 +134,14 @@ void printStats(const RenderStats& st) {
   std::fprintf(stderr, "  estimates: %llu time-dependent, %llu standard\n", u(st.timeEstimates),
                u(st.standardEstimates));
   // Issue 24: where an estimate reads few photons it is noisy (and was biased).
-  if (st.causticEstimates + st.globalEstimates > 0)
-    std::fprintf(stderr, "  estimates from fewer than %d photons: caustic %llu of %llu, global %llu of %llu\n",
-                 estimate::kFewPhotons, u(st.fewCausticEstimates), u(st.causticEstimates), u(st.fewGlobalEstimates),
-                 u(st.globalEstimates));
+  std::string few;
+  uint64_t knn = 0;
+  for (MapKind k : kAllMapKinds) {
+    few += std::string(few.empty() ? "" : ", ") + mapKindName(k) + " " + std::to_string(st.maps[k].fewEstimates) +
+           " of " + std::to_string(st.maps[k].estimates);
+    knn += st.maps[k].estimates;
+  }
+  if (knn > 0) std::fprintf(stderr, "  estimates from fewer than %d photons: %s\n", estimate::kFewPhotons, few.c_str());
   std::fprintf(stderr, "  samples per pixel: %d-%d\n", st.minSpp, st.maxSpp);
 }
 
@@ -302,15 +307,14 @@ std::vector<std::string> accumulationSppWarnings(const RenderOptions& o, bool ha
 void warnAccumulationPhotons(const RenderOptions& o, bool hasMotion, const RenderStats& st) {
   if (!renderMethodTraits(o.method).inBetweenFrames || o.progressive) return;
   const int frames = hasMotion ? std::max(1, o.frames) : 1;
-  auto check = [&](const char* kind, size_t asked, size_t stored) {
+  auto check = [&](const char* kind, size_t asked, size_t stored) {  // per map kind
     if (asked > 0 && double(stored) > 1.1 * double(asked))
       std::fprintf(stderr,
                    "tdpm: warning: accumulation: %s %s photons stored, not the %s asked for: each of the %d frames "
                    "traces at least one batch of photon paths (fewer --frames or more photons avoid it)\n",
                    formatCount(stored).c_str(), kind, formatCount(asked).c_str(), frames);
   };
-  check("caustic", o.causticPhotons, st.causticStored);
-  check("global", o.globalPhotons, st.globalStored);
+  for (MapKind k : kAllMapKinds) check(mapKindName(k), o.*mapKindInfo(k).photons, st.maps[k].stored);
 }
 
 }  // namespace
@@ -585,14 +589,16 @@ void printRenderSummary(const RenderArgs& a, const RenderSetup& s, const RenderS
                  a.scene.c_str(), renderMethodName(s.opt.method), ranksNote.c_str(), filmWidth, filmHeight,
                  formatCount(stats.cameraSamples).c_str(), stats.minSpp, stats.maxSpp, totalSeconds, s.output.c_str(),
                  s.preview.c_str());
-    if (renderMethodTraits(s.opt.method).photonMaps)
-      std::fprintf(stderr,
-                   "tdpm: photons: %s caustic (%s emitted), %s global (%s emitted), %.1f bytes each, %.2f s; "
-                   "estimates: %llu time-dependent, %llu standard\n",
-                   formatCount(stats.causticStored).c_str(), formatCount(stats.causticEmitted).c_str(),
-                   formatCount(stats.globalStored).c_str(), formatCount(stats.globalEmitted).c_str(),
-                   stats.bytesPerPhoton, stats.photonSeconds, static_cast<unsigned long long>(stats.timeEstimates),
+    if (renderMethodTraits(s.opt.method).photonMaps) {
+      std::string maps;  // "N caustic (M emitted), ..." in kind order
+      for (MapKind k : kAllMapKinds)
+        maps += (maps.empty() ? "" : ", ") + formatCount(stats.maps[k].stored) + " " + mapKindName(k) + " (" +
+                formatCount(stats.maps[k].emitted) + " emitted)";
+      std::fprintf(stderr, "tdpm: photons: %s, %.1f bytes each, %.2f s; estimates: %llu time-dependent, %llu standard\n",
+                   maps.c_str(), stats.bytesPerPhoton, stats.photonSeconds,
+                   static_cast<unsigned long long>(stats.timeEstimates),
                    static_cast<unsigned long long>(stats.standardEstimates));
+    }
   }
   if (!progressiveSummaryText.empty() && !a.quiet)
     std::fprintf(stderr, "tdpm: progressive: %s\n", progressiveSummaryText.c_str());

@@ -615,7 +615,18 @@ bool sceneHasSpecular(const Scene& scene, bool glossy) {
   return false;
 }
 
-TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, const Progress& progress) {
+namespace {
+
+// What the entry points add to TraceSettings (each caller its own part).
+struct TraceExtras {
+  PathRange range;           // tracePassPhotons
+  bool segment = false;      // traceSegmentPhotons: `store` applies
+  SegmentStore store;
+  bool guide = false;        // traceGuidePhotons: area lights only, exit points kept
+};
+
+TraceResult traceMap(const Scene& scene, const TraceSettings& settings, const TraceExtras& extras,
+                     const Progress& progress) {
   Timer timer;
   TraceResult result;
   float t0, t1;
@@ -628,33 +639,34 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
     t0 = settings.timeOpen;
     t1 = settings.timeClose;
   }
-  if (std::isfinite(settings.storeT0)) {
-    t0 = settings.storeT0;
-    t1 = settings.storeT1;
+  if (extras.segment) {
+    t0 = extras.store.storeT0;
+    t1 = extras.store.storeT1;
   }
   result.store = PhotonStore(t0, t1);
   std::vector<Target> targets;
   if (settings.kind == MapKind::Caustic) targets = specularTargets(scene, settings.glossyCaustics, u0, u1);
   Tracer tracer{scene, settings, targets,
                 makeLightTable(scene, settings.kind == MapKind::Caustic && settings.projection ? &targets : nullptr,
-                               settings.areaLightsOnly),
+                               extras.guide),
                 t0,
                 t1, ts,
                 uint32_t(mix64(settings.seed ^ 0x7173ull)), u0, u1};
   if (settings.storedWanted == 0 || tracer.lights.empty()) return result;
   if (settings.kind == MapKind::Caustic && !sceneHasSpecular(scene, settings.glossyCaustics)) return result;
   const char* stage = settings.kind == MapKind::Caustic ? "caustic photons" : "global photons";
-  if (settings.paths > 0) {
+  const PathRange& range = extras.range;
+  if (range.paths > 0) {
     // A progressive pass: the count is fixed (pass 0's pilot chose it).
-    TDPM_ASSERT(settings.paths % kPathsPerBatch == 0 && settings.firstPath % kPathsPerBatch == 0,
+    TDPM_ASSERT(range.paths % kPathsPerBatch == 0 && range.firstPath % kPathsPerBatch == 0,
                 "progressive photon paths must be whole batches");
-    tracer.batchOffset = settings.firstPath / kPathsPerBatch;
-    uint64_t batches = settings.paths / kPathsPerBatch;
-    result.emitted = settings.paths;
+    tracer.batchOffset = range.firstPath / kPathsPerBatch;
+    uint64_t batches = range.paths / kPathsPerBatch;
+    result.emitted = range.paths;
     double energyScale = double(tracer.ts) / double(result.emitted);
     size_t expected = settings.storedWanted + size_t(4.0 * std::sqrt(double(settings.storedWanted))) + 1024;
     result.store = tracer.traceBatches(0, batches, energyScale, progress, stage, expected, &result.rays,
-                                       settings.keepExitPoints ? &result.exitPoints : nullptr);
+                                       extras.guide ? &result.exitPoints : nullptr);
     result.store.shrinkToFit();
     result.seconds = timer.seconds();
     return result;
@@ -670,7 +682,7 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   size_t stored = 0;
   uint64_t pilotRays = 0;
   for (;;) {
-    if (settings.storedPerPath > 0) break;  // measured before
+    if (extras.store.storedPerPath > 0) break;  // measured before
     uint64_t rays = 0, lo = 0, hi = 0;
     dist::blockRange(pilotBatches, comm.rank(), comm.size(), lo, hi);
     PhotonStore pilot = tracer.traceBatches(lo, hi, 1.0, Progress{}, stage, 0, &rays);
@@ -686,7 +698,7 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
     if (next <= pilotBatches) break;
     pilotBatches = next;
   }
-  if (stored == 0 && !(settings.storedPerPath > 0)) {
+  if (stored == 0 && !(extras.store.storedPerPath > 0)) {
     // Zero of n: the rate is below 3 / n at 95% confidence.
     uint64_t paths = pilotBatches * kPathsPerBatch;
     result.rays = pilotRays;
@@ -696,7 +708,7 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
                      std::to_string(paths / 3) + " would (95% confidence); the map is empty";
     return result;
   }
-  double perPath = settings.storedPerPath > 0 ? settings.storedPerPath
+  double perPath = extras.store.storedPerPath > 0 ? extras.store.storedPerPath
                                               : double(stored) / double(pilotBatches * kPathsPerBatch);
   result.storedPerPath = perPath;
   double pathsNeeded = double(settings.storedWanted) / perPath;
@@ -714,19 +726,46 @@ TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, cons
   // The final count is Poisson-like around the wanted one: reserve a few
   // standard deviations more so the store rarely needs to grow.
   size_t expected = settings.storedWanted + size_t(4.0 * std::sqrt(double(settings.storedWanted))) + 1024;
-  TDPM_ASSERT(!settings.keepExitPoints || !comm.distributed(), "exit points are kept by one process's maps only");
+  TDPM_ASSERT(!extras.guide || !comm.distributed(), "exit points are kept by one process's maps only");
   if (comm.distributed()) {
     expected = size_t(double(expected) / double(comm.size())) + 1024;
     result.store = traceQueuedBatches(tracer, comm, batches, energyScale, progress, stage, expected, &result.rays);
     comm.allreduceSum(&result.rays, 1);
   } else {
     result.store = tracer.traceBatches(0, batches, energyScale, progress, stage, expected, &result.rays,
-                                       settings.keepExitPoints ? &result.exitPoints : nullptr);
+                                       extras.guide ? &result.exitPoints : nullptr);
   }
   result.rays += pilotRays;
   result.store.shrinkToFit();
   result.seconds = timer.seconds();
   return result;
+}
+
+}  // namespace
+
+TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, const Progress& progress) {
+  return traceMap(scene, settings, TraceExtras{}, progress);
+}
+
+TraceResult tracePassPhotons(const Scene& scene, const TraceSettings& settings, const PathRange& range,
+                             const Progress& progress) {
+  TraceExtras x;
+  x.range = range;
+  return traceMap(scene, settings, x, progress);
+}
+
+TraceResult traceSegmentPhotons(const Scene& scene, const TraceSettings& settings, const SegmentStore& segment,
+                                const Progress& progress) {
+  TraceExtras x;
+  x.segment = true;
+  x.store = segment;
+  return traceMap(scene, settings, x, progress);
+}
+
+TraceResult traceGuidePhotons(const Scene& scene, const TraceSettings& settings, const Progress& progress) {
+  TraceExtras x;
+  x.guide = true;
+  return traceMap(scene, settings, x, progress);
 }
 
 }  // namespace tdpm::photon

@@ -16,13 +16,12 @@
 
 #include "core/progress.h"
 #include "distributed/comm.h"
+#include "photon/map_kind.h"
 #include "photon/store.h"
 #include "sampling/sampler.h"
 #include "scene/scene.h"
 
 namespace tdpm::photon {
-
-enum class MapKind : uint8_t { Caustic, Global };
 
 struct TraceSettings {
   MapKind kind = MapKind::Caustic;
@@ -43,29 +42,11 @@ struct TraceSettings {
   // included) and receives everyone's photons in batch order, so each rank
   // holds the map one process would trace (distributed/comm.h).
   dist::Comm* comm = &dist::local();
-  // Animations (render/animation.h) trace the timeline in segments: path
-  // times spread over [timeOpen, timeClose] (scene seconds, inside the
-  // scene's shutter; NaN: the whole shutter) and the store quantises time
-  // over [storeT0, storeT1] (NaN: the path times' range), so that segments
-  // share one grid of time bins. Energies use ts = timeClose - timeOpen.
+  // When the paths happen, if not over the whole shutter (animation
+  // segments and progressive animation frames): path times spread over
+  // [timeOpen, timeClose] (scene seconds, inside the scene's shutter; NaN:
+  // the whole shutter). Energies use ts = timeClose - timeOpen.
   float timeOpen = std::numeric_limits<float>::quiet_NaN(), timeClose = std::numeric_limits<float>::quiet_NaN();
-  float storeT0 = std::numeric_limits<float>::quiet_NaN(), storeT1 = std::numeric_limits<float>::quiet_NaN();
-  // > 0: photons stored per emitted path, measured before (a pilot over the
-  // whole timeline): the pilot run is skipped and the emission sized by it.
-  double storedPerPath = 0;
-  // Progressive passes (render/progressive.h): paths > 0 traces exactly
-  // that many paths (a multiple of kPathsPerBatch), no pilot, with global
-  // path indices [firstPath, firstPath + paths) (firstPath a multiple of
-  // kPathsPerBatch too): pass i continues the sequences of the passes before.
-  uint64_t firstPath = 0;
-  uint64_t paths = 0;
-  // The path tracer's caustic guide (render/caustic_guide.h): emit from area
-  // lights only (point, spot and sun caustics are not paths a path tracer
-  // can find), and keep each stored photon's last specular vertex in
-  // TraceResult::exitPoints, with the normal of the surface it was stored
-  // on (one process only, not under MPI).
-  bool areaLightsOnly = false;
-  bool keepExitPoints = false;
   // Caustic map: sharp metals (Material::isGlossy) bounce caustic paths
   // like mirrors, so L (S|G)+ D is stored (photons are aimed at them too);
   // false: L S+ D with delta surfaces only (the path tracer's guide, whose
@@ -73,7 +54,25 @@ struct TraceSettings {
   bool glossyCaustics = true;
 };
 
-// Paths per batch: the unit of emission counts and of TraceSettings::firstPath.
+// What one caller alone adds to a trace: each has its own entry point below.
+// Progressive passes (render/progressive.h): exactly `paths` paths (a
+// multiple of kPathsPerBatch), no pilot, with global path indices
+// [firstPath, firstPath + paths) (firstPath a multiple of kPathsPerBatch
+// too): pass i continues the sequences of the passes before.
+struct PathRange {
+  uint64_t firstPath = 0;
+  uint64_t paths = 0;
+};
+// Animation segments (render/animation.h) share one grid of time bins: the
+// store quantises time over [storeT0, storeT1], and the emission is sized
+// by `storedPerPath` (> 0: photons stored per emitted path, measured by a
+// pilot over the frame period) instead of a pilot run of its own.
+struct SegmentStore {
+  float storeT0 = 0, storeT1 = 1;
+  double storedPerPath = 0;
+};
+
+// Paths per batch: the unit of emission counts and of PathRange::firstPath.
 constexpr uint64_t kPathsPerBatch = 1024;
 // A map emits at most this many paths per wanted photon (a scene that
 // stores almost nothing stops there, with a warning): also the bound a
@@ -94,7 +93,7 @@ struct TraceResult {
   double seconds = 0;
   std::string warning;   // set when the map is empty or smaller than wanted
   double storedPerPath = 0;  // the pilot's rate (or the one given), 0 when nothing is stored
-  std::vector<ExitPoint> exitPoints;  // keepExitPoints: photon i's, in store order
+  std::vector<ExitPoint> exitPoints;  // traceGuidePhotons: photon i's, in store order
 };
 
 // Shutter interval the photon store quantises time over. A zero-length
@@ -106,6 +105,18 @@ void photonTimeRange(const Scene& scene, float& t0, float& t1);
 // caustic map) is valid; a scene that stores almost nothing stops after a
 // bounded number of paths instead of hanging.
 TraceResult tracePhotons(const Scene& scene, const TraceSettings& settings, const Progress& progress);
+// A progressive pass's paths (PathRange); `range.paths` 0 traces as above.
+TraceResult tracePassPhotons(const Scene& scene, const TraceSettings& settings, const PathRange& range,
+                             const Progress& progress);
+// An animation segment's paths (SegmentStore).
+TraceResult traceSegmentPhotons(const Scene& scene, const TraceSettings& settings, const SegmentStore& segment,
+                                const Progress& progress);
+// The path tracer's caustic guide (render/caustic_guide.h): emitted from
+// area lights only (point, spot and sun caustics are not paths a path
+// tracer can find), each stored photon's last specular vertex kept in
+// TraceResult::exitPoints with the normal of the surface it was stored on.
+// One process only (not under MPI).
+TraceResult traceGuidePhotons(const Scene& scene, const TraceSettings& settings, const Progress& progress);
 
 // Whether any path could contribute to a caustic map (a delta-only surface).
 // Has a caustic generator: a mirror or glass, or (glossy) a sharp metal.

@@ -27,13 +27,12 @@ namespace {
 // (bins [lo, hi)): traced once, whichever frames use it.
 struct Segment {
   int64_t lo = 0, hi = 0;
-  photon::PhotonStore caustic, global;
-  size_t size() const { return caustic.size() + global.size(); }
-};
-
-struct Kind {
-  photon::MapKind kind;
-  size_t perShutter;  // photons wanted per frame's shutter time
+  PerMap<photon::PhotonStore> stores;  // by map kind
+  size_t size() const {
+    size_t n = 0;
+    for (MapKind k : kAllMapKinds) n += stores[k].size();
+    return n;
+  }
 };
 
 // The grid's cut points that matter for frames [first, last]: the ends of
@@ -57,7 +56,7 @@ bool inside(int64_t lo, int64_t hi, int64_t a, int64_t b) { return lo >= a && hi
 // Frame i's map of one kind: every photon of the segments inside its time
 // map, re-binned on the frame's 256 bins (an integer shift: same grid), and
 // a 3D tree of its shutter's photons alone for the standard estimate.
-std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments, bool caustic, const TimeGrid& g,
+std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments, MapKind kind, const TimeGrid& g,
                                     int frame, bool spaceTime, float kappa) {
   const int64_t lo = g.mapLo(frame), hi = g.mapHi(frame);
   const int64_t s0 = int64_t(frame) * g.binsPerFrame, s1 = s0 + g.shutterBins;
@@ -67,7 +66,7 @@ std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments,
   size_t nAll = 0, nOwn = 0;
   for (const Segment* s : segments) {
     if (!inside(s->lo, s->hi, lo, hi)) continue;
-    size_t n = (caustic ? s->caustic : s->global).size();
+    size_t n = s->stores[kind].size();
     nAll += n;
     if (inside(s->lo, s->hi, s0, s1)) nOwn += n;
   }
@@ -75,7 +74,7 @@ std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments,
   own.reserve(nOwn);
   for (const Segment* s : segments) {
     if (!inside(s->lo, s->hi, lo, hi)) continue;
-    const photon::PhotonStore& st = caustic ? s->caustic : s->global;
+    const photon::PhotonStore& st = s->stores[kind];
     const bool shutter = inside(s->lo, s->hi, s0, s1);
     const int64_t last = s->hi - s->lo - 1;
     for (size_t p = 0; p < st.size(); ++p) {
@@ -126,11 +125,11 @@ AnimationStats renderProgressiveFrames(const Scene& scene, const scene::Animatio
     for (const std::string& w : st.warnings)
       if (std::find(stats.warnings.begin(), stats.warnings.end(), w) == stats.warnings.end()) stats.warnings.push_back(w);
     stats.photonSeconds += st.photonSeconds;
-    stats.causticStored += st.causticStored;
-    stats.globalStored += st.globalStored;
-    stats.causticEmitted += st.causticEmitted;
-    stats.globalEmitted += st.globalEmitted;
-    emitted += st.causticEmitted + st.globalEmitted;
+    for (MapKind k : kAllMapKinds) {
+      stats.maps[k].stored += st.maps[k].stored;
+      stats.maps[k].emitted += st.maps[k].emitted;
+      emitted += st.maps[k].emitted;
+    }
     stats.passesDone += uint64_t(state.passesDone);
     sink(i, std::move(film), st);
     progress.at(WorkPosition{"frame", size_t(i - ao.first + 1), total, 0, emitted});
@@ -195,20 +194,22 @@ void addWarning(AnimationStats& stats, const std::string& w) {
 // Memory: the window's segments (each frame's shutter and pads) and one
 // frame's two copies of its maps, at --photons per shutter.
 void checkAnimationMemory(const Scene& scene, const RenderOptions& opt, const TimeGrid& grid, int window,
-                          int windowFlag, bool photons, bool wantGlobal) {
+                          int windowFlag, bool photons) {
   if (!photons) {
     checkMemoryBudget(scene, opt, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
     return;
   }
   RenderOptions held = opt;
   double factor = double(window + 2) * double(grid.shutterBins + 2 * grid.padBins) / double(grid.shutterBins) + 1.0;
-  held.causticPhotons = size_t(double(opt.causticPhotons) * factor);
-  held.globalPhotons = wantGlobal ? size_t(double(opt.globalPhotons) * factor) : 0;
   // The budget's message names what multiplied the scene's counts.
   const std::string times = " per frame, held for a window of " + std::to_string(window) +
                             " frames at once (--window " + std::to_string(windowFlag) + ")";
-  held.causticPhotonsSource = opt.causticPhotonsSource + " (" + std::to_string(opt.causticPhotons) + times + ")";
-  held.globalPhotonsSource = opt.globalPhotonsSource + " (" + std::to_string(opt.globalPhotons) + times + ")";
+  const PerMap<size_t> wanted = photonsWanted(opt);
+  for (MapKind k : kAllMapKinds) {
+    const MapKindInfo& row = mapKindInfo(k);
+    held.*row.photons = size_t(double(wanted[k]) * factor);
+    held.*row.photonsSource = opt.*row.photonsSource + " (" + std::to_string(opt.*row.photons) + times + ")";
+  }
   checkMemoryBudget(scene, held, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
 }
 
@@ -218,9 +219,9 @@ void checkAnimationMemory(const Scene& scene, const RenderOptions& opt, const Ti
 class SegmentTimeline {
  public:
   SegmentTimeline(const Scene& scene, const scene::AnimationDesc& anim, const RenderOptions& opt,
-                  const AnimationOptions& ao, const TimeGrid& grid, std::vector<Kind> kinds, const Progress& framed,
-                  AnimationStats& stats)
-      : scene_(scene), anim_(anim), opt_(opt), ao_(ao), grid_(grid), kinds_(std::move(kinds)), framed_(framed),
+                  const AnimationOptions& ao, const TimeGrid& grid, const PerMap<size_t>& perShutter,
+                  const Progress& framed, AnimationStats& stats)
+      : scene_(scene), anim_(anim), opt_(opt), ao_(ao), grid_(grid), perShutter_(perShutter), framed_(framed),
         stats_(stats), cuts_(cutPoints(grid, anim.frames, ao.first, ao.last)) {}
 
   // Trace the segments frames [w0, w1] need that are not held yet.
@@ -259,17 +260,12 @@ class SegmentTimeline {
   // that frame's time map (the caustic map aims at where the specular
   // objects are then). Segments of the period size their emission by it,
   // so a frame's photons do not depend on the range or window of the run.
-  double rateFor(int64_t period, const Kind& kd) {
-    auto key = std::pair{period, int(kd.kind)};
+  double rateFor(int64_t period, MapKind kind) {
+    auto key = std::pair{period, int(kind)};
     auto it = rates_.find(key);
     if (it != rates_.end()) return it->second;
     const int64_t timelineEnd = int64_t(anim_.frames) * grid_.binsPerFrame;
-    photon::TraceSettings ts;
-    ts.kind = kd.kind;
-    ts.storedWanted = 1;
-    ts.seed = hashCombine(opt_.seed, 0x9170ull, uint64_t(period));
-    ts.maxBounces = opt_.maxDepth;
-    ts.sampler = opt_.sampler;
+    photon::TraceSettings ts = traceSettingsFor(opt_, kind, 1, hashCombine(opt_.seed, 0x9170ull, uint64_t(period)));
     int frame = int(std::clamp<int64_t>(period, 0, anim_.frames - 1));
     ts.timeOpen = float(double(std::max<int64_t>(0, grid_.mapLo(frame))) * grid_.binWidth);
     ts.timeClose = float(double(std::min(timelineEnd, grid_.mapHi(frame))) * grid_.binWidth);
@@ -289,29 +285,26 @@ class SegmentTimeline {
     int64_t phase = lo % grid_.binsPerFrame;
     uint64_t key = ao_.independentFrames ? uint64_t(lo) | (uint64_t(1) << 62) : uint64_t(phase);
     const int64_t period = std::clamp<int64_t>((lo + grid_.padBins) / grid_.binsPerFrame, 0, anim_.frames - 1);
-    for (const Kind& kd : kinds_) {
-      if (kd.perShutter == 0) continue;
-      double rate = rateFor(period, kd);
+    for (MapKind kind : kAllMapKinds) {
+      if (perShutter_[kind] == 0) continue;
+      double rate = rateFor(period, kind);
       if (!(rate > 0)) continue;
-      photon::TraceSettings ts;
-      ts.kind = kd.kind;
       double share = double(hi - lo) / (double(grid_.binsPerFrame) * anim_.shutterAngle / 360.0);
-      ts.storedWanted = size_t(std::max(1.0, std::round(double(kd.perShutter) * share)));
-      ts.seed = hashCombine(opt_.seed, key, uint64_t(hi - lo));
-      ts.maxBounces = opt_.maxDepth;
-      ts.sampler = opt_.sampler;
+      photon::TraceSettings ts =
+          traceSettingsFor(opt_, kind, size_t(std::max(1.0, std::round(double(perShutter_[kind]) * share))),
+                           hashCombine(opt_.seed, key, uint64_t(hi - lo)));
       ts.timeOpen = float(double(lo) * grid_.binWidth);
       ts.timeClose = float(double(hi) * grid_.binWidth);
-      ts.storeT0 = ts.timeOpen;
-      ts.storeT1 = float(double(lo + photon::kTimeBins) * grid_.binWidth);
-      ts.storedPerPath = rate;
-      photon::TraceResult r = photon::tracePhotons(scene_, ts, framed_);
+      photon::SegmentStore grid;  // the timeline's bins, and the period's measured rate
+      grid.storeT0 = ts.timeOpen;
+      grid.storeT1 = float(double(lo + photon::kTimeBins) * grid_.binWidth);
+      grid.storedPerPath = rate;
+      photon::TraceResult r = photon::traceSegmentPhotons(scene_, ts, grid, framed_);
       addWarning(stats_, r.warning);
       emitted_ += r.emitted;
-      bool c = kd.kind == photon::MapKind::Caustic;
-      (c ? stats_.causticStored : stats_.globalStored) += r.store.size();
-      (c ? stats_.causticEmitted : stats_.globalEmitted) += r.emitted;
-      (c ? seg.caustic : seg.global) = std::move(r.store);
+      stats_.maps[kind].stored += r.store.size();
+      stats_.maps[kind].emitted += r.emitted;
+      seg.stores[kind] = std::move(r.store);
     }
     return seg;
   }
@@ -321,7 +314,7 @@ class SegmentTimeline {
   const RenderOptions& opt_;
   const AnimationOptions& ao_;
   const TimeGrid& grid_;
-  const std::vector<Kind> kinds_;
+  const PerMap<size_t> perShutter_;  // photons wanted per frame's shutter time, by kind
   const Progress& framed_;
   AnimationStats& stats_;
   const std::vector<int64_t> cuts_;
@@ -337,27 +330,25 @@ void renderTimelineFrame(const Scene& scene, const scene::AnimationDesc& anim, c
                          const Progress& framed, AnimationStats& stats, const FrameSink& sink) {
   FrameInput in;
   in.shutter = frameShutter(anim, frame);
-  std::unique_ptr<PhotonMap> caustic, global;
+  PerMap<std::unique_ptr<PhotonMap>> maps;
   size_t heldNow = timeline.heldPhotons();
   if (photons) {
     Timer mapTimer;
     std::vector<const Segment*> segs = timeline.segments();
-    caustic = frameMap(segs, true, grid, frame, spaceTime, opt.kappa);
-    global = frameMap(segs, false, grid, frame, spaceTime, opt.kappa);
-    in.caustic = caustic.get();
-    in.global = global.get();
-    heldNow += caustic->store.size() + caustic->store3.size() + global->store.size() + global->store3.size();
+    for (MapKind k : kAllMapKinds) {
+      maps[k] = frameMap(segs, k, grid, frame, spaceTime, opt.kappa);
+      in.maps[k] = maps[k].get();
+      heldNow += maps[k]->store.size() + maps[k]->store3.size();
+    }
     stats.photonSeconds += mapTimer.seconds();
   }
   stats.peakHeldPhotons = std::max(stats.peakHeldPhotons, heldNow);
   RenderStats st;
   Film film = renderFrame(scene, opt, in, framed, st);
-  if (photons) {
-    st.causticStored = caustic->store3.size();  // the frame's own shutter
-    st.globalStored = global->store3.size();
+  for (MapKind k : kAllMapKinds) {
+    if (photons) st.maps[k].stored = maps[k]->store3.size();  // the frame's own shutter
+    maps[k].reset();
   }
-  caustic.reset();
-  global.reset();
   sink(frame, std::move(film), st);
 }
 
@@ -379,7 +370,6 @@ AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& a
                                                                      : double(opt.maxDtFraction);
   const TimeGrid grid = makeTimeGrid(anim, reach);
   const bool photons = method.photonMaps;
-  const bool wantGlobal = opt.visualizeGlobal || opt.gatherRays > 0;
   const bool spaceTime = opt.spaceTime4D && method.timeDependentEstimate && scene.hasMotion;  // the 4D tree serves it alone
   const size_t total = size_t(ao.last - ao.first + 1);
   // A window wider than the frames rendered holds nothing more (issue 27
@@ -387,18 +377,13 @@ AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& a
   // photons). Frames' photons do not depend on the window, so capping it
   // changes no image.
   const int window = int(std::min<int64_t>(ao.window, int64_t(total)));
-  checkAnimationMemory(scene, opt, grid, window, ao.window, photons, wantGlobal);
+  checkAnimationMemory(scene, opt, grid, window, ao.window, photons);
 
   std::string prefix;
   Progress framed;
   framed.report = [&](const std::string& stage, size_t done, size_t all) { progress(prefix + stage, done, all); };
   framed.position = progress.position;
-  std::vector<Kind> kinds;
-  if (photons)
-    for (auto [kind, count] : {std::pair{photon::MapKind::Caustic, opt.causticPhotons},
-                               std::pair{photon::MapKind::Global, wantGlobal ? opt.globalPhotons : size_t(0)}})
-      kinds.push_back(Kind{kind, count});
-  SegmentTimeline timeline(scene, anim, opt, ao, grid, std::move(kinds), framed, stats);
+  SegmentTimeline timeline(scene, anim, opt, ao, grid, photons ? photonsWanted(opt) : PerMap<size_t>{}, framed, stats);
 
   progress.at(WorkPosition{"frame", 0, total, 0, 0});
   for (int w0 = ao.first; w0 <= ao.last; w0 += window) {

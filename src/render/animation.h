@@ -53,7 +53,7 @@ struct AnimationOptions {
 
 struct AnimationStats {
   double photonSeconds = 0;                   // tracing, and building frame maps
-  uint64_t causticStored = 0, globalStored = 0, causticEmitted = 0, globalEmitted = 0;
+  PerMap<MapStats> maps;                      // stored and emitted per map kind
   uint64_t segmentsTraced = 0;
   uint64_t passesDone = 0;                    // --progressive: passes of all frames (no segments are traced)
   size_t peakHeldPhotons = 0;                 // segments + the frame's maps, at most

@@ -93,11 +93,9 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
   t.storedWanted = s.photons;
   t.seed = hashCombine(s.seed, 0x6775696465ull);  // "guide": apart from the render's own streams
   t.sampler = s.sampler;
-  t.areaLightsOnly = true;
-  t.keepExitPoints = true;
   t.glossyCaustics = false;  // cones aim at delta exit points only
   t.comm = &dist::local();  // every rank traces the same guide itself
-  photon::TraceResult traced = photon::tracePhotons(scene, t, progress);
+  photon::TraceResult traced = photon::traceGuidePhotons(scene, t, progress);  // area lights, exit points kept
   if (traced.store.size() < size_t(kNeighbours) || traced.exitPoints.size() != traced.store.size()) return g;
 
   g.emitted_ = traced.emitted;
@@ -137,24 +135,35 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
   if (!(radius > 0.0f) || !std::isfinite(radius)) return CausticGuide();
   g.radius2_ = radius * radius;
 
-  // Each photon's cone half-angle, once: 1.5x the median angle, seen from
-  // the photon, between its k nearest photons' exit directions and their
-  // own nearest other, so the cones join into one cover of the light's
-  // image. A vertex takes the median of its photons' half-angles (or the
-  // spread of its own photons' directions, if wider). Kept as 1 - cos.
-  // (The compact k-NN: the kd-tree's result, read from one record a node.)
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, g.photons_.size(), 1024),
+  g.setConeAngles();
+  std::vector<Vec3f> positions(g.store_->size());
+  for (size_t i = 0; i < positions.size(); ++i) positions[i] = g.store_->position(i);
+  g.occupancy_ = GuideOccupancy::build(positions, radius, kMinFound);
+  g.orderRecords();
+  g.fraction_ = s.fraction;
+  g.allocateCache(cacheSubdivision);
+  return g;
+}
+
+// Each photon's cone half-angle, once: 1.5x the median angle, seen from
+// the photon, between its k nearest photons' exit directions and their
+// own nearest other, so the cones join into one cover of the light's
+// image. A vertex takes the median of its photons' half-angles (or the
+// spread of its own photons' directions, if wider). Kept as 1 - cos.
+// (The compact k-NN: the kd-tree's result, read from one record a node.)
+void CausticGuide::setConeAngles() {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, photons_.size(), 1024),
                     [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
-      Vec3f p = g.store_->position(i);
+      Vec3f p = store_->position(i);
       uint32_t nearIndex[kNeighbours + 1];
       float nearDist2[kNeighbours + 1];
-      int found = g.nearestWithin(p, g.radius2_, nearIndex, nearDist2);
+      int found = nearestWithin(p, radius2_, nearIndex, nearDist2);
       Vec3f axis[kNeighbours];
       int count = 0;
-      const Vec3f facing = g.photons_[i].facing();
+      const Vec3f facing = photons_[i].facing();
       for (int j = 0; j < found; ++j) {
-        const GuidePhoton& o = g.photons_[nearIndex[j]];
+        const GuidePhoton& o = photons_[nearIndex[j]];
         if (!(dot(o.facing(), facing) > kMinNormalCosine)) continue;
         Vec3f d = o.exit - p;
         float len = length(d);
@@ -174,16 +183,9 @@ CausticGuide CausticGuide::build(const Scene& scene, const CausticGuideSettings&
         half = std::clamp(1.5f * angle, kMinHalfAngle, kMaxHalfAngle);
       }
       float sh = std::sin(0.5f * half);
-      g.photons_[i].oneMinusCos = 2.0f * sh * sh;
+      photons_[i].oneMinusCos = 2.0f * sh * sh;
     }
   });
-  std::vector<Vec3f> positions(g.store_->size());
-  for (size_t i = 0; i < positions.size(); ++i) positions[i] = g.store_->position(i);
-  g.occupancy_ = GuideOccupancy::build(positions, radius, kMinFound);
-  g.orderRecords();
-  g.fraction_ = s.fraction;
-  g.allocateCache(cacheSubdivision);
-  return g;
 }
 
 // Spreads the low 10 bits of v over every third bit.

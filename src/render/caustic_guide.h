@@ -146,6 +146,7 @@ class CausticGuide {
   size_t photonCount_ = 0;
   std::vector<uint32_t> treeOfRecord_, recordOfTree_;
   void orderRecords();
+  void setConeAngles();  // every photon's cone half-angle (build)
   int nearestWithin(Vec3f p, float r2, uint32_t* index, float* dist2) const;
   void allocateCache(int subdivision);
   // The sub-cell's list (record indices, in the k-NN's heap order), filled now

@@ -71,8 +71,6 @@ std::map<std::string, std::string> renderSettings(const RenderOptions& o, int wi
       {"max_spp", std::to_string(o.maxSpp)},
       {"contrast", floatText(o.contrast)},
       {"max_depth", std::to_string(o.maxDepth)},
-      {"photons", std::to_string(o.causticPhotons)},
-      {"global_photons", std::to_string(o.globalPhotons)},
       {"frames", std::to_string(o.frames)},
       {"search", o.spaceTime4D ? "4d" : "twopass"},
       {"kappa", floatText(o.kappa)},
@@ -95,6 +93,8 @@ std::map<std::string, std::string> renderSettings(const RenderOptions& o, int wi
       {"kernel_footprint", floatText(o.kernelFootprint)},
       {"alpha", o.alpha > 0 ? floatText(o.alpha) : "auto"},
   };
+  // The photon counts, by the kinds' option names ("photons", "global_photons").
+  for (MapKind k : kAllMapKinds) s[mapKindInfo(k).optionName] = std::to_string(o.*mapKindInfo(k).photons);
   // Progressive passes' per-pixel sample counts (render/sample_allocation.h):
   // one key, present only when they are on, so that a render without them
   // keeps the fingerprint it had before they existed.

@@ -7,6 +7,24 @@
 
 namespace tdpm {
 
+// The bits (a cell with at least minCount points in reach) and the words'
+// running ranks, from the per-cell counts of build().
+void GuideOccupancy::setBits(const std::vector<uint8_t>& count, int minCount) {
+  bx_ = (nx_ + 3) / 4;
+  by_ = (ny_ + 3) / 4;
+  bz_ = (nz_ + 3) / 4;
+  words_.assign(size_t(bx_) * size_t(by_) * size_t(bz_), Word{0, 0, 0});
+  for (int z = 0; z < nz_; ++z)
+    for (int y = 0; y < ny_; ++y)
+      for (int x = 0; x < nx_; ++x)
+        if (count[cellIndex(x, y, z)] >= minCount) words_[wordIndex(x, y, z)].bits |= uint64_t(1) << bitIndex(x, y, z);
+  uint32_t before = 0;
+  for (Word& w : words_) {
+    w.rank = before;
+    before += uint32_t(__builtin_popcountll(w.bits));
+  }
+}
+
 GuideOccupancy GuideOccupancy::build(const std::vector<Vec3f>& points, float radius, int minCount, size_t maxCells) {
   GuideOccupancy g;
   if (points.empty() || !(radius > 0.0f) || !std::isfinite(radius) || minCount < 1 || minCount > 255) return g;
@@ -81,19 +99,7 @@ GuideOccupancy GuideOccupancy::build(const std::vector<Vec3f>& points, float rad
         }
       }
   }
-  g.bx_ = (g.nx_ + 3) / 4;
-  g.by_ = (g.ny_ + 3) / 4;
-  g.bz_ = (g.nz_ + 3) / 4;
-  g.words_.assign(size_t(g.bx_) * size_t(g.by_) * size_t(g.bz_), Word{0, 0, 0});
-  for (int z = 0; z < g.nz_; ++z)
-    for (int y = 0; y < g.ny_; ++y)
-      for (int x = 0; x < g.nx_; ++x)
-        if (count[g.cellIndex(x, y, z)] >= minCount) g.words_[g.wordIndex(x, y, z)].bits |= uint64_t(1) << bitIndex(x, y, z);
-  uint32_t before = 0;
-  for (Word& w : g.words_) {
-    w.rank = before;
-    before += uint32_t(__builtin_popcountll(w.bits));
-  }
+  g.setBits(count, minCount);
   g.built_ = true;
   return g;
 }

@@ -75,6 +75,7 @@ class GuideOccupancy {
   size_t setCount() const;  // cells whose bit is set (for stats and tests)
 
  private:
+  void setBits(const std::vector<uint8_t>& count, int minCount);  // build: the bits from the counts
   Vec3f cellCorner(int x, int y, int z) const {
     return Vec3f(lo_.x + float(x) * cell_, lo_.y + float(y) * cell_, lo_.z + float(z) * cell_);
   }

@@ -20,11 +20,24 @@ std::string formatBytes(uint64_t b) {
   return std::to_string(b) + " bytes (" + buf + ")";
 }
 
+// Bytes per stored photon, as photon/ holds them (docs/photon-map.md):
+constexpr uint64_t kStoreBytes = 20;        // the store; the kd-tree adds nothing
+// Tracing appends chunks of batches to a store reserved for the expected
+// count (photon/tracer.cpp), then shrinks it to fit: one copy of the store.
+constexpr uint64_t kShrinkBytes = 20;
+// A chunk's per-batch buffers: up to 2x the photons they hold from vector
+// growth, for at most kChunkPaths paths (kBatchesPerChunk x kPathsPerBatch).
+constexpr uint64_t kChunkBytes = 2 * 20;
+constexpr uint64_t kChunkPaths = 256 * 1024;
+constexpr uint64_t kBuild3Bytes = 16 + 5;   // kd-tree builder: 3D keys + index, then permutation + axis
+constexpr uint64_t kBuild4Bytes = 20 + 5;   // 4D keys + index, permutation + axis
+constexpr uint64_t kPilotPaths = 16 * 1024; // photon/tracer.cpp: 16 pilot batches of 1024 paths
+
 // The photon maps the options will really trace (a caustic map needs a
 // specular surface, any map needs a light; accumulation traces 1/N per
 // frame, one frame's maps at a time).
 struct PhotonCounts {
-  size_t caustic = 0, global = 0;
+  PerMap<size_t> stored;
   bool spaceTime = false;
 };
 
@@ -32,19 +45,75 @@ PhotonCounts photonCounts(const Scene& scene, const RenderOptions& opt) {
   PhotonCounts p;
   const RenderMethodTraits& method = renderMethodTraits(opt.method);
   if (!method.photonMaps || scene.lights.empty()) return p;
-  p.caustic = photon::sceneHasSpecular(scene) ? opt.causticPhotons : 0;
-  p.global = wantsGlobalMap(opt) ? opt.globalPhotons : 0;
+  p.stored = photonsWanted(opt);
+  if (!photon::sceneHasSpecular(scene)) p.stored[MapKind::Caustic] = 0;
   if (method.inBetweenFrames) {
     size_t frames = size_t(scene.hasMotion ? std::max(1, opt.frames) : 1);
-    p.caustic = (p.caustic + frames - 1) / frames;
-    p.global = (p.global + frames - 1) / frames;
+    for (MapKind k : kAllMapKinds) p.stored[k] = (p.stored[k] + frames - 1) / frames;
   } else {
     p.spaceTime = opt.spaceTime4D && method.spreadsPhotonsInTime && scene.hasMotion;
   }
   return p;
 }
 
+PerMap<std::string> photonSources(const RenderOptions& opt) {
+  PerMap<std::string> s;
+  for (MapKind k : kAllMapKinds) s[k] = opt.*mapKindInfo(k).photonsSource;
+  return s;
+}
+
 }  // namespace
+
+uint64_t photonMemoryBytes(const PerMap<size_t>& stored, bool spaceTime4D, int maxDepth) {
+  // One map: what it keeps, and the most it holds at once while it is made.
+  auto kept = [&](uint64_t n) { return n * kStoreBytes * (spaceTime4D ? 2 : 1); };
+  auto peak = [&](uint64_t n, uint64_t storedPerPilotPath) {
+    if (n == 0) return uint64_t(0);
+    uint64_t chunk = std::min<uint64_t>(n, kChunkPaths * storedPerPilotPath) * kChunkBytes;
+    uint64_t tracing = n * (kStoreBytes + kShrinkBytes) + chunk;
+    // 3D: store + builder. 4D: the 3D copy is kept while the 4D tree is built.
+    uint64_t building = spaceTime4D ? n * (2 * kStoreBytes + kBuild4Bytes) : n * (kStoreBytes + kBuild3Bytes);
+    uint64_t pilot = kPilotPaths * storedPerPilotPath * (kStoreBytes + kChunkBytes);
+    return std::max({tracing, building, pilot});
+  };
+  // The maps are traced in kind order, each while the ones before are held.
+  // A caustic path stores at most one photon; a global path one per bounce.
+  uint64_t held = 0, most = 0;
+  for (MapKind k : kAllMapKinds) {
+    const uint64_t perPath = mapKindInfo(k).storesEveryBounce ? uint64_t(std::max(1, maxDepth)) + 1 : 1;
+    most = std::max(most, held + peak(stored[k], perPath));
+    held += kept(stored[k]);
+  }
+  return most;
+}
+
+uint64_t memoryMarginBytes(uint64_t available) { return (uint64_t(256) << 20) + available / 16; }
+
+void checkPhotonMemory(const PerMap<size_t>& stored, bool spaceTime4D, int maxDepth, uint64_t available,
+                       const PerMap<std::string>& sources) {
+  if (available == 0) return;  // unknown: better to try than to refuse
+  uint64_t margin = memoryMarginBytes(available);
+  uint64_t usable = available > margin ? available - margin : 0;
+  uint64_t needed = photonMemoryBytes(stored, spaceTime4D, maxDepth);
+  if (needed <= usable) return;
+  // Blame the count that alone does not fit, else all together.
+  std::string what, names, counts;
+  for (MapKind k : kAllMapKinds) {
+    PerMap<size_t> alone;
+    alone[k] = stored[k];
+    const std::string count = std::to_string(stored[k]) + " " + mapKindName(k);
+    if (what.empty() && photonMemoryBytes(alone, spaceTime4D, maxDepth) > usable)
+      what = sources[k] + " asks for " + count + " photons";
+    names += (names.empty() ? "" : " and ") + sources[k];
+    counts += (counts.empty() ? "" : " and ") + count;
+  }
+  if (what.empty()) what = names + " ask for " + counts + " photons";
+  throw Error(what + (spaceTime4D ? " with --search 4d" : "") + ", which need about " + formatBytes(needed) +
+              " while tracing and building the kd-trees, but only " + formatBytes(usable) +
+              " of memory is available (MemAvailable " + formatBytes(available) + " less a margin of " +
+              formatBytes(margin) + "); lower the photon counts");
+}
+
 
 uint64_t MemoryEstimate::peak() const { return std::max(films + sampler + samples + photons, write); }
 
@@ -57,7 +126,7 @@ MemoryEstimate estimateRenderMemory(const Scene& scene, const RenderOptions& opt
   e.sampler = kSamplerBytesPerPixel * e.pixels;  // one film is sampled at a time
   e.samples = uint64_t(std::max(1, threads)) * uint64_t(std::max(1, opt.spp)) * kSampleBytes;
   PhotonCounts p = photonCounts(scene, opt);
-  e.photons = photonMemoryBytes(p.caustic, p.global, p.spaceTime, opt.maxDepth);
+  e.photons = photonMemoryBytes(p.stored, p.spaceTime, opt.maxDepth);
   e.write = kWriteBytesPerPixel * e.pixels;
   return e;
 }
@@ -72,8 +141,7 @@ void checkMemoryBudget(const Scene& scene, const RenderOptions& opt, int threads
   const uint64_t imageAlone = std::max(e.films + e.sampler + e.samples, e.write);
   // The photons alone do not fit: the photon budget's own message.
   if (imageAlone <= usable && e.photons > usable)
-    checkPhotonMemory(p.caustic, p.global, p.spaceTime, opt.maxDepth, available, opt.causticPhotonsSource,
-                      opt.globalPhotonsSource);
+    checkPhotonMemory(p.stored, p.spaceTime, opt.maxDepth, available, photonSources(opt));
   const std::string image = opt.resolutionSource + " (" + std::to_string(scene.camera.width()) + "x" +
                             std::to_string(scene.camera.height()) + " = " + std::to_string(e.pixels) + " pixels)";
   const std::string imageNeeds =
@@ -83,9 +151,11 @@ void checkMemoryBudget(const Scene& scene, const RenderOptions& opt, int threads
                              formatBytes(available) + " less a margin of " + formatBytes(margin) + ")";
   if (imageAlone > usable)
     throw Error(image + " needs about " + imageNeeds + limits + "; lower the resolution");
-  throw Error(image + " and the photon maps (" + opt.causticPhotonsSource + ": " + std::to_string(p.caustic) +
-              " caustic, " + opt.globalPhotonsSource + ": " + std::to_string(p.global) +
-              " global) together need about " + formatBytes(e.peak()) + ": " + imageNeeds + " and " +
+  std::string maps;
+  for (MapKind k : kAllMapKinds)
+    maps += (maps.empty() ? "" : ", ") + opt.*mapKindInfo(k).photonsSource + ": " + std::to_string(p.stored[k]) + " " +
+            mapKindName(k);
+  throw Error(image + " and the photon maps (" + maps + ") together need about " + formatBytes(e.peak()) + ": " + imageNeeds + " and " +
               formatBytes(e.photons) + " for the photons" + limits + "; lower the resolution or the photon counts");
 }
 

@@ -1,7 +1,7 @@
 // render/memory_budget.h — the one memory pre-flight of a render: the
 // image (films while rendering, the EXR and PNG buffers while writing), the
-// per-thread sample buffers and the photon maps (render/renderer.h
-// photonMemoryBytes), summed and checked against MemAvailable before any
+// per-thread sample buffers and the photon maps (photonMemoryBytes, per
+// kind), summed and checked against MemAvailable before any
 // work, so an impossible --resolution or photon count is a located error
 // and not an OOM kill half an hour in.
 #pragma once
@@ -22,6 +22,24 @@ constexpr uint64_t kFilmBytesPerPixel = 2 * 12 + 4;
 constexpr uint64_t kWriteBytesPerPixel = kFilmBytesPerPixel + 12;
 // Per camera sample of a batch, per thread: the sample (12) + its strata (12).
 constexpr uint64_t kSampleBytes = 24;
+
+// ---- the photon maps' model ----
+// Peak bytes the photon passes hold for maps of `stored` photons per kind
+// (each map is traced while the ones before it in kind order are held):
+// 20 bytes per stored photon, a second 3D-ordered copy for the 4D search,
+// and the transients: the per-batch buffers while tracing (up to 2x their
+// size from vector growth, alive until they are concatenated) or the
+// kd-tree builder's keys and permutation, plus the pilot run.
+uint64_t photonMemoryBytes(const PerMap<size_t>& stored, bool spaceTime4D, int maxDepth);
+// Memory kept back from MemAvailable for everything that is not photons
+// (scene, film, threads, other processes' growth).
+uint64_t memoryMarginBytes(uint64_t available);
+// Throws tdpm::Error naming the source of each count (the flag or scene key
+// that set it; the one whose map alone does not fit, else all), the bytes
+// needed and the bytes available when photonMemoryBytes(...) > available -
+// margin. available == 0 means unknown (no /proc): no check.
+void checkPhotonMemory(const PerMap<size_t>& stored, bool spaceTime4D, int maxDepth, uint64_t available,
+                       const PerMap<std::string>& sources);
 
 struct MemoryEstimate {
   uint64_t pixels = 0;

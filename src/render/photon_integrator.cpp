@@ -17,9 +17,9 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kSplitGlassVertices = 2;  // traceFrom
 }  // namespace
 
-PhotonIntegrator::PhotonIntegrator(const Scene& scene, const PhotonMap* caustic, const PhotonMap* global,
+PhotonIntegrator::PhotonIntegrator(const Scene& scene, const PerMap<const PhotonMap*>& maps,
                                    const PhotonIntegratorSettings& settings)
-    : scene_(scene), caustic_(caustic), global_(global), s_(settings) {
+    : scene_(scene), caustic_(maps[MapKind::Caustic]), global_(maps[MapKind::Global]), s_(settings) {
   // The floor of r^2 (coincident photons) relative to the scene: an
   // absolute 1e-12 m^2 is a disc as large as a whole scene at 1e-6 scale,
   // which blurred its caustic away (max 0.58 instead of 8).
@@ -30,28 +30,26 @@ PhotonIntegrator::PhotonIntegrator(const Scene& scene, const PhotonMap* caustic,
 void PhotonIntegrator::flush(ThreadState& ts) const {
   standardCount_ += ts.counts.standard;
   timeCount_ += ts.counts.timeDependent;
-  causticCount_ += ts.counts.caustic;
-  globalCount_ += ts.counts.global;
-  fewCausticCount_ += ts.counts.fewCaustic;
-  fewGlobalCount_ += ts.counts.fewGlobal;
+  for (MapKind k : kAllMapKinds) {
+    mapCount_[size_t(k)] += ts.counts.estimates[k];
+    fewCount_[size_t(k)] += ts.counts.few[k];
+  }
   ts.counts = {};
 }
 
 EstimateCounts PhotonIntegrator::counts() const {
-  return {standardCount_.load(), timeCount_.load(), causticCount_.load(), globalCount_.load(),
-          fewCausticCount_.load(), fewGlobalCount_.load()};
+  EstimateCounts c{standardCount_.load(), timeCount_.load(), {}, {}};
+  for (MapKind k : kAllMapKinds) {
+    c.estimates[k] = mapCount_[size_t(k)].load();
+    c.few[k] = fewCount_[size_t(k)].load();
+  }
+  return c;
 }
 
 // Per-map k-NN estimate counts, and those from few photons (--stats).
-static void countEstimate(EstimateCounts& c, bool caustic, int summed) {
-  bool few = summed < estimate::kFewPhotons;
-  if (caustic) {
-    ++c.caustic;
-    c.fewCaustic += few;
-  } else {
-    ++c.global;
-    c.fewGlobal += few;
-  }
+static void countEstimate(EstimateCounts& c, MapKind kind, int summed) {
+  ++c.estimates[kind];
+  c.few[kind] += summed < estimate::kFewPhotons;
 }
 
 Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::Gatherer>& g,
@@ -68,7 +66,7 @@ Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::G
   uint8_t tag = photon::surfaceTag(hit.object, dot(hit.n, wo) < 0.0f);
   if (s_.fixedKernels) {
     if (!ts.fixed) ts.fixed = std::make_unique<estimate::FixedKernelGatherer>();
-    const estimate::MapKernel& k = map == caustic_ ? s_.causticKernel : s_.globalKernel;
+    const estimate::MapKernel& k = s_.kernels[kindOf(map)];
     if (timeDependent) {
       ++counts.timeDependent;
       float t = scene_.shutter.instant() ? map->store.t0() : scene_.shutter.fromNormalized(time01);
@@ -86,7 +84,7 @@ Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::G
     }
     float t = scene_.shutter.instant() ? map->store.t0() : scene_.shutter.fromNormalized(time01);
     Rgb L = g->radiance(hit.p, n, wo, t, brdf, nullptr, tag, minVolume);
-    countEstimate(counts, map == caustic_, g->lastSummed());
+    countEstimate(counts, kindOf(map), g->lastSummed());
     return L;
   }
   ++counts.standard;
@@ -96,7 +94,7 @@ Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::G
     g3 = std::make_unique<estimate::Gatherer>(map->spatialTree(), o);
   }
   Rgb L = g3->standard(hit.p, n, wo, brdf, nullptr, tag);
-  countEstimate(counts, map == caustic_, g3->lastSummed());
+  countEstimate(counts, kindOf(map), g3->lastSummed());
   return L;
 }
 

@@ -13,6 +13,7 @@
 // exactly the time average the pixel wants there. Counts of both are kept.
 #pragma once
 #include <cstdint>
+#include <array>
 #include <atomic>
 #include <memory>
 
@@ -42,7 +43,7 @@ struct PhotonIntegratorSettings {
   // space-time kernel where the time-dependent estimate applies, the spatial
   // one over the whole shutter elsewhere (the skip rule).
   bool fixedKernels = false;
-  estimate::MapKernel causticKernel, globalKernel;
+  PerMap<estimate::MapKernel> kernels;
 };
 
 struct EstimateCounts {
@@ -50,7 +51,7 @@ struct EstimateCounts {
   // k-NN estimates per map, and those whose sum ran over fewer than
   // estimate::kFewPhotons photons (--stats; issue 24). Counted per thread,
   // summed at flush. The progressive fixed kernels are not counted here.
-  uint64_t caustic = 0, global = 0, fewCaustic = 0, fewGlobal = 0;
+  PerMap<uint64_t> estimates, few;
 };
 
 class PhotonIntegrator {
@@ -61,8 +62,9 @@ class PhotonIntegrator {
     EstimateCounts counts;
   };
 
-  PhotonIntegrator(const Scene& scene, const PhotonMap* caustic, const PhotonMap* global,
-                   const PhotonIntegratorSettings& settings);
+  // The maps by kind (PhotonMaps::view(), render/photon_map.h); null or
+  // empty maps add nothing.
+  PhotonIntegrator(const Scene& scene, const PerMap<const PhotonMap*>& maps, const PhotonIntegratorSettings& settings);
 
   // Stream: RandomStream or SobolStream (sampling/sampler.h dimension order).
   template <class Stream>
@@ -118,7 +120,8 @@ class PhotonIntegrator {
   const PhotonMap* global_;
   PhotonIntegratorSettings s_;
   mutable std::atomic<uint64_t> standardCount_{0}, timeCount_{0};
-  mutable std::atomic<uint64_t> causticCount_{0}, globalCount_{0}, fewCausticCount_{0}, fewGlobalCount_{0};
+  mutable std::array<std::atomic<uint64_t>, kMapKinds> mapCount_{}, fewCount_{};
+  MapKind kindOf(const PhotonMap* map) const { return map == caustic_ ? MapKind::Caustic : MapKind::Global; }
 };
 
 }  // namespace tdpm

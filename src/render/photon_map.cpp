@@ -1,21 +1,40 @@
-// render/photon_map.cpp — trace, then build the tree(s).
+// render/photon_map.cpp — the one set-up and builder of a render's photon
+// maps: trace each kind, then build its tree(s).
 #include "render/photon_map.h"
 
 #include "core/timer.h"
 
 namespace tdpm {
 
-PhotonMapSettings photonMapSettingsFor(const RenderOptions& opt, photon::MapKind kind, size_t wanted, uint64_t seed,
-                                       bool spreadInTime, float fixedTime01) {
-  PhotonMapSettings ms;
-  ms.trace.kind = kind;
-  ms.trace.storedWanted = wanted;
-  ms.trace.seed = seed;
-  ms.trace.maxBounces = opt.maxDepth;
-  ms.trace.spreadInTime = spreadInTime;
-  ms.trace.fixedTime01 = fixedTime01;
-  ms.trace.sampler = opt.sampler;
-  return ms;
+PerMap<size_t> photonsWanted(const RenderOptions& opt) {
+  PerMap<size_t> wanted;
+  for (MapKind k : kAllMapKinds) {
+    const MapKindInfo& row = mapKindInfo(k);
+    wanted[k] = row.onlyWhenGathered && !wantsGlobalMap(opt) ? 0 : opt.*row.photons;
+  }
+  return wanted;
+}
+
+photon::TraceSettings traceSettingsFor(const RenderOptions& opt, MapKind kind, size_t wanted, uint64_t seed) {
+  photon::TraceSettings ts;
+  ts.kind = kind;
+  ts.storedWanted = wanted;
+  ts.seed = seed;
+  ts.maxBounces = opt.maxDepth;
+  ts.sampler = opt.sampler;
+  return ts;
+}
+
+PerMap<PhotonMapSettings> photonMapSettingsFor(const RenderOptions& opt, const PerMap<size_t>& wanted, uint64_t seed,
+                                               bool spreadInTime, float fixedTime01) {
+  PerMap<PhotonMapSettings> all;
+  for (MapKind k : kAllMapKinds) {
+    PhotonMapSettings& ms = all[k];
+    ms.trace = traceSettingsFor(opt, k, wanted[k], seed);
+    ms.trace.spreadInTime = spreadInTime;
+    ms.trace.fixedTime01 = fixedTime01;
+  }
+  return all;
 }
 
 double PhotonMap::bytesPerPhoton() const {
@@ -27,7 +46,7 @@ double PhotonMap::bytesPerPhoton() const {
 std::unique_ptr<PhotonMap> buildPhotonMap(const Scene& scene, const PhotonMapSettings& settings,
                                           const Progress& progress) {
   auto map = std::make_unique<PhotonMap>();
-  photon::TraceResult traced = photon::tracePhotons(scene, settings.trace, progress);
+  photon::TraceResult traced = photon::tracePassPhotons(scene, settings.trace, settings.pass, progress);
   map->store = std::move(traced.store);
   map->emitted = traced.emitted;
   map->traceSeconds = traced.seconds;
@@ -46,6 +65,40 @@ std::unique_ptr<PhotonMap> buildPhotonMap(const Scene& scene, const PhotonMapSet
   map->tree = photon::KdTree::build(map->store, opt);
   map->buildSeconds = timer.seconds();
   return map;
+}
+
+PerMap<const PhotonMap*> PhotonMaps::view() const {
+  PerMap<const PhotonMap*> v;
+  for (MapKind k : kAllMapKinds) v[k] = maps[k].get();
+  return v;
+}
+
+double PhotonMaps::bytesPerPhoton() const {
+  size_t n = 0;
+  for (MapKind k : kAllMapKinds) n += maps[k]->size();
+  if (n == 0) return 0.0;
+  double bytes = 0.0;
+  for (MapKind k : kAllMapKinds) bytes += maps[k]->bytesPerPhoton() * double(maps[k]->size());
+  return bytes / double(n);
+}
+
+PhotonMaps buildPhotonMaps(const Scene& scene, const PerMap<PhotonMapSettings>& settings, const Progress& progress) {
+  PhotonMaps maps;
+  for (MapKind k : kAllMapKinds) maps.maps[k] = buildPhotonMap(scene, settings[k], progress);
+  return maps;
+}
+
+void addMapFigures(RenderStats& st, const PhotonMaps& maps) {
+  for (MapKind k : kAllMapKinds) {
+    const PhotonMap& m = *maps[k];
+    st.photonSeconds += m.traceSeconds + m.buildSeconds;
+    if (!m.warning.empty()) st.warnings.push_back(m.warning);
+    st.maps[k].stored += m.size();
+    st.maps[k].emitted += m.emitted;
+  }
+  size_t n = 0;
+  for (MapKind k : kAllMapKinds) n += maps[k]->size();
+  if (n > 0) st.bytesPerPhoton = maps.bytesPerPhoton();  // else an earlier frame's stands
 }
 
 }  // namespace tdpm

@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <cfloat>
 #include <cmath>
 #include <csignal>
@@ -55,11 +56,6 @@ double shutterOf(const Scene& scene, const RenderOptions& opt) {
   float t0, t1;
   photon::photonTimeRange(scene, t0, t1);
   return double(t1) - double(t0);
-}
-
-double scalarOr(const ProgressiveState& s, const std::string& key, double fallback) {
-  auto it = s.scalars.find(key);
-  return it == s.scalars.end() ? fallback : it->second;
 }
 
 double median(std::vector<double>& v) {
@@ -127,11 +123,10 @@ estimate::MapKernel pilotKernel(const PhotonMap* map, const Scene& scene, const 
   return k;
 }
 
-void storeKernel(ProgressiveState& st, const char* map, const estimate::MapKernel& k) {
-  std::string p = std::string("kernel.") + map + ".";
-  st.scalars[p + "radius_1"] = double(k.radius);
-  st.scalars[p + "half_window_1"] = double(k.halfWindow);
-  st.scalars[p + "spatial_radius_1"] = double(k.spatialRadius);
+void storeKernel(ProgressiveMapPilot& pilot, const estimate::MapKernel& k) {
+  pilot.radius = double(k.radius);
+  pilot.halfWindow = double(k.halfWindow);
+  pilot.spatialRadius = double(k.spatialRadius);
 }
 
 float mainAlpha(const RenderOptions& opt) {
@@ -220,46 +215,46 @@ void renderPassPixels(const Scene& scene, const PhotonIntegrator& integ, const R
 // fixed order (they cross the network under mpirun; counts stay exact
 // below 2^53).
 struct PassFigures {
-  double causticStored = 0, globalStored = 0, causticEmitted = 0, globalEmitted = 0;
+  PerMap<double> stored, emitted;
   double standardEstimates = 0, timeEstimates = 0, photonSeconds = 0, bytesPerPhoton = 0, seconds = 0;
-  static constexpr size_t kCount = 9;
+  static constexpr size_t kCount = 2 * kMapKinds + 5;
   std::vector<double> pack() const {
-    return {causticStored, globalStored, causticEmitted, globalEmitted, standardEstimates,
-            timeEstimates, photonSeconds, bytesPerPhoton, seconds};
+    std::vector<double> v;
+    for (MapKind k : kAllMapKinds) v.insert(v.end(), {stored[k], emitted[k]});
+    v.insert(v.end(), {standardEstimates, timeEstimates, photonSeconds, bytesPerPhoton, seconds});
+    return v;
   }
   static PassFigures unpack(const double* v) {
     PassFigures f;
-    f.causticStored = v[0], f.globalStored = v[1], f.causticEmitted = v[2], f.globalEmitted = v[3];
-    f.standardEstimates = v[4], f.timeEstimates = v[5], f.photonSeconds = v[6], f.bytesPerPhoton = v[7];
-    f.seconds = v[8];
+    for (MapKind k : kAllMapKinds) {
+      f.stored[k] = *v++;
+      f.emitted[k] = *v++;
+    }
+    f.standardEstimates = v[0], f.timeEstimates = v[1], f.photonSeconds = v[2], f.bytesPerPhoton = v[3];
+    f.seconds = v[4];
     return f;
   }
 };
 
-// The scalars pass 0 fixes for every later pass (paths per pass from the
-// tracer's pilot, pass 1's kernels from the k-NN pilot): what the other
-// ranks need before their first pass.
-const char* const kPilotScalars[] = {"photons.caustic_paths_per_pass",  "photons.global_paths_per_pass",
-                                     "kernel.caustic.radius_1",         "kernel.caustic.half_window_1",
-                                     "kernel.caustic.spatial_radius_1", "kernel.global.radius_1",
-                                     "kernel.global.half_window_1",     "kernel.global.spatial_radius_1"};
-constexpr size_t kPilotCount = sizeof kPilotScalars / sizeof kPilotScalars[0];
-
-bool hasPilot(const ProgressiveState& s) { return s.scalars.count("kernel.caustic.radius_1") > 0; }
-
-// Rank 0's pilot scalars into every rank's state (collective).
-// Rank 0 sends its pilot values; `valid` false (rank 0's pass 0 was
-// cancelled before its pilot ended) tells the others there are none, and
-// they return false without touching their state.
+// Rank 0's pilot values (render/progressive_state.h ProgressivePilot:
+// what pass 0 fixes for every later pass) into every rank's state
+// (collective). `valid` false (rank 0's pass 0 was cancelled before its
+// pilot ended) tells the others there are none, and they return false
+// without touching their state.
 bool sharePilot(dist::Comm& comm, ProgressiveState& s, bool valid = true) {
-  double v[kPilotCount + 1] = {};
+  constexpr size_t kPerMap = 4;
+  double v[kPerMap * kMapKinds + 1] = {};
+  auto fields = [](ProgressiveMapPilot& m) { return std::array<double*, kPerMap>{&m.pathsPerPass, &m.radius, &m.halfWindow, &m.spatialRadius}; };
   if (comm.root()) {
-    for (size_t i = 0; i < kPilotCount; ++i) v[i] = scalarOr(s, kPilotScalars[i], 0);
-    v[kPilotCount] = valid ? 1.0 : 0.0;
+    for (MapKind k : kAllMapKinds)
+      for (size_t i = 0; i < kPerMap; ++i) v[kPerMap * size_t(k) + i] = *fields(s.pilot.maps[k])[i];
+    v[kPerMap * kMapKinds] = valid ? 1.0 : 0.0;
   }
   comm.broadcast(v, sizeof v, 0);
-  if (v[kPilotCount] == 0.0) return false;
-  for (size_t i = 0; i < kPilotCount; ++i) s.scalars[kPilotScalars[i]] = v[i];
+  if (v[kPerMap * kMapKinds] == 0.0) return false;
+  for (MapKind k : kAllMapKinds)
+    for (size_t i = 0; i < kPerMap; ++i) *fields(s.pilot.maps[k])[i] = v[kPerMap * size_t(k) + i];
+  s.pilot.done = true;
   return true;
 }
 
@@ -291,7 +286,7 @@ Progress cancellable(const Progress& progress) {
 }
 
 // Renders pass `pass` into `mean` (3 floats a pixel) without touching the
-// sums. Reads the pilot scalars from `state`, or (pass 0 of a new render)
+// sums. Reads the pilot values from `state`, or (pass 0 of a new render)
 // computes them into it and then calls `afterPilot` (may be empty). Only
 // warnings go to `st`; the rest is in the figures, for addPass.
 PassFigures computePass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state, int pass,
@@ -303,41 +298,39 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
   const bool spread = method.spreadsPhotonsInTime && scene.hasMotion;
   const float passTime = accumulation && scene.hasMotion ? accumulationPassTime(pass, opt.seed) : -1.0f;
 
-  double photonSeconds = 0;
   // ---- photons: pass 0 sizes the emission with the tracer's pilot; later
   //      passes trace the same number of paths at the next path indices ----
-  auto trace = [&](photon::MapKind kind, size_t wanted, const char* key) -> std::unique_ptr<PhotonMap> {
-    PhotonMapSettings ms = photonMapSettingsFor(opt, kind, wanted, opt.seed, spread, passTime >= 0 ? passTime : 0.0f);
+  PerMap<PhotonMapSettings> settings =
+      photonMapSettingsFor(opt, photonsWanted(opt), opt.seed, spread, passTime >= 0 ? passTime : 0.0f);
+  for (MapKind kind : kAllMapKinds) {
+    photon::TraceSettings& ts = settings[kind].trace;
     if (std::isfinite(opt.frameOpen)) {  // an animation frame: its shutter alone (the fixed kernel clips its window to it)
-      ms.trace.timeOpen = opt.frameOpen;
-      ms.trace.timeClose = opt.frameClose;
+      ts.timeOpen = opt.frameOpen;
+      ts.timeClose = opt.frameClose;
     }
-    auto it = state.scalars.find(key);
-    if (it != state.scalars.end()) {
-      // A resumed value was checked (render/progressive_check.h): a whole
-      // number of batches, small enough for every pass index.
-      uint64_t paths = uint64_t(it->second);
-      if (paths == 0) ms.trace.storedWanted = 0;
-      ms.trace.paths = paths;
-      TDPM_ASSERT(paths == 0 || uint64_t(pass) + 1 <= UINT64_MAX / paths, "progressive photon path index overflows");
-      ms.trace.firstPath = uint64_t(pass) * paths;
-    }
-    std::unique_ptr<PhotonMap> m = buildPhotonMap(scene, ms, progress);
-    if (it == state.scalars.end()) state.scalars[key] = double(m->emitted);
-    photonSeconds += m->traceSeconds + m->buildSeconds;
-    if (!m->warning.empty() && pass == 0) st.warnings.push_back(m->warning);
-    return m;
-  };
-  const bool wantGlobal = wantsGlobalMap(opt);
-  std::unique_ptr<PhotonMap> caustic = trace(photon::MapKind::Caustic, opt.causticPhotons, "photons.caustic_paths_per_pass");
-  std::unique_ptr<PhotonMap> global =
-      trace(photon::MapKind::Global, wantGlobal ? opt.globalPhotons : 0, "photons.global_paths_per_pass");
+    if (!state.pilot.done) continue;  // pass 0: the tracer's pilot sizes the emission
+    // A resumed value was checked (render/progressive_check.h): a whole
+    // number of batches, small enough for every pass index.
+    uint64_t paths = uint64_t(state.pilot.maps[kind].pathsPerPass);
+    if (paths == 0) ts.storedWanted = 0;
+    settings[kind].pass.paths = paths;
+    TDPM_ASSERT(paths == 0 || uint64_t(pass) + 1 <= UINT64_MAX / paths, "progressive photon path index overflows");
+    settings[kind].pass.firstPath = uint64_t(pass) * paths;
+  }
+  PhotonMaps maps = buildPhotonMaps(scene, settings, progress);
+  double photonSeconds = 0;
+  for (MapKind kind : kAllMapKinds) {
+    const PhotonMap& m = *maps[kind];
+    if (!state.pilot.done) state.pilot.maps[kind].pathsPerPass = double(m.emitted);
+    photonSeconds += m.traceSeconds + m.buildSeconds;
+    if (!m.warning.empty() && pass == 0) st.warnings.push_back(m.warning);
+  }
 
   // ---- kernels: pass 1's from a k-NN pilot on pass 0's maps ----
   const bool timeDependent = renderMethodTraits(opt.method).timeDependentEstimate && scene.hasMotion;
-  if (!hasPilot(state)) {
-    storeKernel(state, "caustic", pilotKernel(caustic.get(), scene, opt, timeDependent));
-    storeKernel(state, "global", pilotKernel(global.get(), scene, opt, timeDependent));
+  if (!state.pilot.done) {
+    for (MapKind kind : kAllMapKinds) storeKernel(state.pilot.maps[kind], pilotKernel(maps[kind], scene, opt, timeDependent));
+    state.pilot.done = true;
     if (afterPilot) afterPilot();
   }
   PassKernels k = kernelsForPass(state, opt, scene, pass);
@@ -348,9 +341,8 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
   is.visualizeGlobal = opt.visualizeGlobal;
   is.maxDepth = opt.maxDepth;
   is.fixedKernels = true;
-  is.causticKernel = k.caustic;
-  is.globalKernel = k.global;
-  PhotonIntegrator integ(scene, caustic.get(), global.get(), is);
+  is.kernels = k;
+  PhotonIntegrator integ(scene, maps.view(), is);
   std::string stage = "pass " + std::to_string(pass + 1) + " render";
   if (opt.sampler == SamplerKind::Random)
     renderPassPixels<RandomPixelSampler>(scene, integ, opt, pass, opt.spp, counts, passTime, stage, progress, mean);
@@ -361,14 +353,11 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
   EstimateCounts c = integ.counts();
   f.standardEstimates = double(c.standard);
   f.timeEstimates = double(c.timeDependent);
-  f.causticStored = double(caustic->size());
-  f.globalStored = double(global->size());
-  f.causticEmitted = double(caustic->emitted);
-  f.globalEmitted = double(global->emitted);
-  size_t n = caustic->size() + global->size();
-  if (n > 0)
-    f.bytesPerPhoton = (caustic->bytesPerPhoton() * double(caustic->size()) +
-                        global->bytesPerPhoton() * double(global->size())) / double(n);
+  for (MapKind kind : kAllMapKinds) {
+    f.stored[kind] = double(maps[kind]->size());
+    f.emitted[kind] = double(maps[kind]->emitted);
+  }
+  f.bytesPerPhoton = maps.bytesPerPhoton();
   f.photonSeconds = photonSeconds;
   f.seconds = timer.seconds();
   return f;
@@ -417,23 +406,28 @@ std::string addPass(const Scene& scene, const RenderOptions& opt, ProgressiveSta
   }
   st.standardEstimates += uint64_t(f.standardEstimates);
   st.timeEstimates += uint64_t(f.timeEstimates);
-  st.causticStored += size_t(f.causticStored);
-  st.globalStored += size_t(f.globalStored);
-  st.causticEmitted += uint64_t(f.causticEmitted);
-  st.globalEmitted += uint64_t(f.globalEmitted);
+  double emitted = 0, stored = 0;  // over the maps, in kind order
+  for (MapKind k : kAllMapKinds) {
+    st.maps[k].stored += size_t(f.stored[k]);
+    st.maps[k].emitted += uint64_t(f.emitted[k]);
+    emitted += f.emitted[k];
+    stored += f.stored[k];
+  }
   st.photonSeconds += f.photonSeconds;
-  if (f.causticStored + f.globalStored > 0) st.bytesPerPhoton = f.bytesPerPhoton;
+  if (stored > 0) st.bytesPerPhoton = f.bytesPerPhoton;
 
   const bool timeDependent = renderMethodTraits(opt.method).timeDependentEstimate && scene.hasMotion;
   PassKernels k = kernelsForPass(state, opt, scene, pass);
   state.passesDone = pass + 1;
-  auto& sc = state.scalars;
-  sc["photons.emitted"] = scalarOr(state, "photons.emitted", 0) + (f.causticEmitted + f.globalEmitted);
-  sc["photons.stored"] = scalarOr(state, "photons.stored", 0) + (f.causticStored + f.globalStored);
-  sc["kernel.radius"] = double(timeDependent ? k.caustic.radius : k.caustic.spatialRadius);
-  sc["kernel.spatial_radius"] = double(k.caustic.spatialRadius);
-  sc["kernel.half_window"] = timeDependent ? double(k.caustic.halfWindow) : 0.0;
-  sc["seconds"] = scalarOr(state, "seconds", 0) + f.seconds;
+  ProgressiveTotals& t = state.totals;
+  t.photonsEmitted += emitted;
+  t.photonsStored += stored;
+  // Reported (not read back): the caustic map's kernel, the one users tune.
+  const estimate::MapKernel& kc = k[MapKind::Caustic];
+  t.kernelRadius = double(timeDependent ? kc.radius : kc.spatialRadius);
+  t.kernelSpatialRadius = double(kc.spatialRadius);
+  t.kernelHalfWindow = timeDependent ? double(kc.halfWindow) : 0.0;
+  t.seconds += f.seconds;
   return overflow;
 }
 
@@ -465,10 +459,10 @@ PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& o
   // fallback 2/3; the other variants have only the spatial kernel (d = 2).
   const double s3 = kernelScale(pass, alpha, 3);
   const double s2 = kernelScale(pass, time ? kAlphaSpatial : alpha, 2);
-  auto one = [&](const char* map) {
-    std::string p = std::string("kernel.") + map + ".";
+  auto one = [&](MapKind kind) {
+    const ProgressiveMapPilot& pilot = state.pilot.maps[kind];
     estimate::MapKernel k;
-    double r1 = scalarOr(state, p + "radius_1", 0), h1 = scalarOr(state, p + "half_window_1", 0);
+    double r1 = pilot.radius, h1 = pilot.halfWindow;
     double r = r1 * s3, h = h1 * s3;
     if (h < binWidth && h1 > 0) {
       // Below one time bin the window cannot resolve more (photon/store.h):
@@ -478,10 +472,12 @@ PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& o
     }
     k.radius = float(r);
     k.halfWindow = float(h);
-    k.spatialRadius = float(scalarOr(state, p + "spatial_radius_1", 0) * s2);
+    k.spatialRadius = float(pilot.spatialRadius * s2);
     return k;
   };
-  return {one("caustic"), one("global")};
+  PassKernels all;
+  for (MapKind kind : kAllMapKinds) all[kind] = one(kind);
+  return all;
 }
 
 void runProgressivePass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
@@ -523,7 +519,7 @@ namespace {
 // Where the pass loop stands, for the progress bar and pass lines.
 WorkPosition passPosition(const ProgressiveState& state, const RenderOptions& opt, double limit) {
   return WorkPosition{"pass", size_t(state.passesDone), size_t(std::max(0, opt.passes)), limit,
-                      uint64_t(scalarOr(state, "photons.emitted", 0))};
+                      uint64_t(state.totals.photonsEmitted)};
 }
 
 // A new state gets its zero layers and its settings; a resumed one is
@@ -532,7 +528,8 @@ void prepareState(ProgressiveState& state, const RenderOptions& opt, int w, int 
   const size_t n = size_t(w) * size_t(h);
   if (state.empty()) {
     state.layers.clear();
-    state.scalars.clear();
+    state.pilot = {};
+    state.totals = {};
   }
   for (const char* name : kLayers) {
     if (!comm.root()) break;  // the sums live on rank 0 only
@@ -549,13 +546,12 @@ void prepareState(ProgressiveState& state, const RenderOptions& opt, int w, int 
                       {"seed", std::to_string(opt.seed)},
                       {"sampler", samplerName(opt.sampler)},
                       {"spp", std::to_string(opt.spp)},
-                      {"photons", std::to_string(opt.causticPhotons)},
-                      {"global_photons", std::to_string(opt.globalPhotons)},
                       {"alpha", a},
                       {"max_depth", std::to_string(opt.maxDepth)},
                       {"gather", std::to_string(opt.gatherRays)},
                       {"k", std::to_string(opt.estimate.k)},
                       {"resolution", std::to_string(w) + "x" + std::to_string(h)}};
+    for (MapKind k : kAllMapKinds) state.settings[mapKindInfo(k).optionName] = std::to_string(opt.*mapKindInfo(k).photons);
   }
 }
 
@@ -590,7 +586,7 @@ bool runDistributedRounds(const Scene& scene, const RenderOptions& opt, Progress
         std::min(opt.passes > 0 ? std::min(N, opt.passes - first) : N, maxProgressivePasses() - first);
     if (inRound <= 0) break;
     const bool has = rank < inRound;
-    const bool needPilot = !hasPilot(state);
+    const bool needPilot = !state.pilot.done;
     bool cancelled = false, pilotSent = false;
     if (needPilot && !comm.root()) cancelled = !sharePilot(comm, state);
     std::vector<float> mean;

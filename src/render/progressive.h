@@ -43,17 +43,15 @@ constexpr double kDefaultProgressiveSeconds = 30.0;
 constexpr float kAlphaSpaceTime = 4.0f / 7.0f;  // disc x window, d = 3
 constexpr float kAlphaSpatial = 2.0f / 3.0f;    // disc, d = 2
 
-// Both kernels of each map for one pass.
-struct PassKernels {
-  estimate::MapKernel caustic, global;
-};
+// Both kernels (space-time, spatial) of each map for one pass.
+using PassKernels = PerMap<estimate::MapKernel>;
 
 // Relative size of pass `pass`'s (0-based) kernel to pass 0's, for a kernel
 // of `dims` dimensions whose volume shrinks as V_{j+1} = V_j (j + a)/(j + 1)
 // (j 1-based): (V_{pass+1} / V_1)^(1/dims). Deterministic (a double product).
 double kernelScale(int pass, double alpha, int dims);
 
-// The kernels of pass `pass` from pass 0's (state.scalars "kernel.*_1"),
+// The kernels of pass `pass` from pass 0's (state.pilot),
 // with the half window floored at one photon time bin (shutter / 256; the
 // volume schedule is then kept by the radius).
 PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& opt, const Scene& scene, int pass);

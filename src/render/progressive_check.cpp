@@ -12,19 +12,13 @@
 
 #include "core/error.h"
 #include "photon/tracer.h"
+#include "render/progressive_io.h"
 #include "scene/limits.h"
 
 namespace tdpm {
 
 namespace {
 
-// Every scalar the pass loop writes (render/progressive.cpp), and nothing else.
-const char* const kCausticPaths = "photons.caustic_paths_per_pass";
-const char* const kGlobalPaths = "photons.global_paths_per_pass";
-const char* const kKernelScalars[] = {"kernel.caustic.radius_1",         "kernel.caustic.half_window_1",
-                                      "kernel.caustic.spatial_radius_1", "kernel.global.radius_1",
-                                      "kernel.global.half_window_1",     "kernel.global.spatial_radius_1"};
-const char* const kReportScalars[] = {"kernel.radius", "kernel.spatial_radius", "kernel.half_window"};
 const char* const kLayerNames[] = {"sum.R", "sum.G", "sum.B", "sumsq.R", "sumsq.G", "sumsq.B", "spp"};
 
 // Float counts are exact integers up to here.
@@ -50,17 +44,13 @@ struct Checker {
 
   Error bad(const std::string& what) const { return Error("damaged progressive state: " + path + ": " + what); }
 
-  double scalar(const std::string& name) const {
-    auto it = s.scalars.find(name);
-    if (it == s.scalars.end()) throw bad("tdpm/progressive/scalar/" + name + " is missing");
-    if (!std::isfinite(it->second)) throw bad("tdpm/progressive/scalar/" + name + " is " + g(it->second) + ", not finite");
-    return it->second;
-  }
-  // A finite scalar in [lo, hi] (lo excluded when `open`).
-  double inRange(const std::string& name, double lo, double hi, bool open, const std::string& why) const {
-    double v = scalar(name);
-    if (v < lo || v > hi || (open && v == lo))
-      throw bad("tdpm/progressive/scalar/" + name + " is " + g(v) + ", " + why);
+  // A scalar of the state by its name on disk (render/progressive_io.h),
+  // finite, in [lo, hi] (lo excluded when `open`).
+  double inRange(const ProgressiveScalar& sc, double lo, double hi, bool open, const std::string& why) const {
+    const double v = *sc.value;
+    const std::string name = "tdpm/progressive/scalar/" + sc.name;
+    if (!std::isfinite(v)) throw bad(name + " is " + g(v) + ", not finite");
+    if (v < lo || v > hi || (open && v == lo)) throw bad(name + " is " + g(v) + ", " + why);
     return v;
   }
 };
@@ -72,14 +62,14 @@ double pathCap(double wanted) {
   return std::max(1.0, batches) * double(photon::kPathsPerBatch);
 }
 
-double checkPaths(const Checker& c, const char* name, double wanted, const char* flag) {
+double checkPaths(const Checker& c, const ProgressiveScalar& sc, double wanted, const std::string& flag) {
   const double cap = pathCap(wanted);
-  double v = c.inRange(name, 0, wanted > 0 ? cap : 0, false,
+  double v = c.inRange(sc, 0, wanted > 0 ? cap : 0, false,
                        wanted > 0 ? "outside [0, " + g(cap) + "]: " + flag + " " + g(wanted) +
                                         " emits at most that many paths per pass"
                                   : std::string("but this render traces no such photons (") + flag + "), so it must be 0");
   if (std::fmod(v, double(photon::kPathsPerBatch)) != 0)
-    throw c.bad(std::string("tdpm/progressive/scalar/") + name + " is " + g(v) + ", not a whole number of " +
+    throw c.bad("tdpm/progressive/scalar/" + sc.name + " is " + g(v) + ", not a whole number of " +
                 std::to_string(photon::kPathsPerBatch) + "-path batches");
   return v;
 }
@@ -136,41 +126,55 @@ void checkProgressiveState(const ProgressiveState& s, const RenderOptions& opt, 
   if (s.passesDone < 1 || s.passesDone > maxProgressivePasses())
     throw c.bad("tdpm/progressive/passes is " + std::to_string(s.passesDone) + ", outside [1, " +
                 std::to_string(maxProgressivePasses()) + "]");
-  std::set<std::string> known{kCausticPaths, kGlobalPaths, "photons.emitted", "photons.stored", "seconds"};
-  known.insert(std::begin(kKernelScalars), std::end(kKernelScalars));
-  known.insert(std::begin(kReportScalars), std::end(kReportScalars));
-  for (const auto& kv : s.scalars)
-    if (!known.count(kv.first))
-      throw c.bad("tdpm/progressive/scalar/" + kv.first + " is not a value a progressive render writes");
+  using R = ProgressiveScalarRole;
+  const std::vector<ProgressiveScalar> scalars = progressiveScalars(s);
+  if (!s.pilot.done) throw c.bad("tdpm/progressive/scalar/" + scalars[0].name + " is missing");
+  auto named = [&](const std::string& name) -> const ProgressiveScalar& {
+    for (const ProgressiveScalar& sc : scalars)
+      if (sc.name == name) return sc;
+    TDPM_ASSERT(false, "render/progressive_io.cpp has no scalar " + name);
+    return scalars[0];
+  };
 
   const double passes = double(s.passesDone);
   const bool wantGlobal = opt.visualizeGlobal || opt.gatherRays > 0;
-  const double cp = checkPaths(c, kCausticPaths, double(opt.causticPhotons),
-                               opt.causticPhotons > 0 ? opt.causticPhotonsSource.c_str() : "its caustic photons are 0");
-  const double gp = checkPaths(c, kGlobalPaths, wantGlobal ? double(opt.globalPhotons) : 0.0,
-                               !wantGlobal ? "--gather 0 without --global-direct"
-                               : opt.globalPhotons > 0 ? opt.globalPhotonsSource.c_str()
-                                                       : "its global photons are 0");
+  // Paths per pass of each map: within what its photon count may emit.
+  double paths = 0, most = -1;
+  const ProgressiveScalar* largest = nullptr;
+  for (const ProgressiveScalar& sc : scalars) {
+    if (sc.role != R::Paths) continue;
+    const MapKindInfo& row = mapKindInfo(sc.kind);
+    const bool traced = !row.onlyWhenGathered || wantGlobal;
+    const size_t count = opt.*row.photons;
+    const std::string why = !traced       ? std::string("--gather 0 without --global-direct")
+                            : count > 0 ? opt.*row.photonsSource
+                                        : std::string("its ") + row.name + " photons are 0";
+    const double v = checkPaths(c, sc, traced ? double(count) : 0.0, why);
+    paths += v;
+    if (v > most) most = v, largest = &sc;
+  }
   // Pass i traces paths [i p, (i + 1) p) (photon/tracer.h firstPath, 64 bits);
   // the passes this run may add must keep that in range.
   const double lastPass = std::max(passes + 1, double(opt.passes));
-  if (lastPass * std::max(cp, gp) > 0x1p62)
-    throw c.bad("tdpm/progressive/scalar/" + std::string(cp >= gp ? kCausticPaths : kGlobalPaths) + " is " +
-                g(std::max(cp, gp)) + ": " + g(lastPass) + " passes of it overflow the path index");
-  const double emitted = c.inRange("photons.emitted", 0, DBL_MAX, false, "negative");
-  const double expected = passes * (cp + gp);
+  if (lastPass * most > 0x1p62)
+    throw c.bad("tdpm/progressive/scalar/" + largest->name + " is " + g(most) + ": " + g(lastPass) +
+                " passes of it overflow the path index");
+  const double emitted = c.inRange(named("photons.emitted"), 0, DBL_MAX, false, "negative");
+  const double expected = passes * paths;
   if (std::fabs(emitted - expected) > 1e-12 * expected)
     throw c.bad("tdpm/progressive/scalar/photons.emitted is " + g(emitted) + ", not passes x paths per pass = " +
-                g(passes) + " x " + g(cp + gp) + " = " + g(expected));
-  const double stored = c.inRange("photons.stored", 0, DBL_MAX, false, "negative");
+                g(passes) + " x " + g(paths) + " = " + g(expected));
+  const double stored = c.inRange(named("photons.stored"), 0, DBL_MAX, false, "negative");
   if (std::floor(stored) != stored) throw c.bad("tdpm/progressive/scalar/photons.stored is " + g(stored) + ", not a count");
   if (emitted == 0 && stored > 0)
     throw c.bad("tdpm/progressive/scalar/photons.stored is " + g(stored) + ", but no photon path was emitted");
-  c.inRange("seconds", 0, DBL_MAX, false, "negative");
+  c.inRange(named("seconds"), 0, DBL_MAX, false, "negative");
   // Pass 1's kernels from the pilot (render/progressive.cpp pilotKernel):
   // positive floats; every later pass scales them down.
-  for (const char* name : kKernelScalars) c.inRange(name, 0, FLT_MAX, true, "not a positive float");
-  for (const char* name : kReportScalars) c.inRange(name, 0, FLT_MAX, false, "not a float >= 0");
+  for (const ProgressiveScalar& sc : scalars) {
+    if (sc.role == R::Kernel) c.inRange(sc, 0, FLT_MAX, true, "not a positive float");
+    if (sc.role == R::Report) c.inRange(sc, 0, FLT_MAX, false, "not a float >= 0");
+  }
   checkLayers(c, opt, width, height);
 }
 

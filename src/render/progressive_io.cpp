@@ -8,6 +8,7 @@
 #include <cctype>
 #include <cstdint>
 #include <cstdlib>
+#include <map>
 #include <set>
 
 #include "core/error.h"
@@ -41,6 +42,28 @@ std::vector<std::string> splitNames(const std::string& s) {
 }
 
 }  // namespace
+
+std::vector<ProgressiveScalar> progressiveScalars(const ProgressiveState& s) {
+  using R = ProgressiveScalarRole;
+  std::vector<ProgressiveScalar> v;
+  for (MapKind k : kAllMapKinds)
+    v.push_back({std::string("photons.") + mapKindName(k) + "_paths_per_pass", R::Paths, k, &s.pilot.maps[k].pathsPerPass});
+  for (MapKind k : kAllMapKinds) {
+    const std::string p = std::string("kernel.") + mapKindName(k) + ".";
+    const ProgressiveMapPilot& m = s.pilot.maps[k];
+    v.push_back({p + "radius_1", R::Kernel, k, &m.radius});
+    v.push_back({p + "half_window_1", R::Kernel, k, &m.halfWindow});
+    v.push_back({p + "spatial_radius_1", R::Kernel, k, &m.spatialRadius});
+  }
+  const ProgressiveTotals& t = s.totals;
+  v.push_back({"photons.emitted", R::Total, MapKind::Caustic, &t.photonsEmitted});
+  v.push_back({"photons.stored", R::Total, MapKind::Caustic, &t.photonsStored});
+  v.push_back({"seconds", R::Total, MapKind::Caustic, &t.seconds});
+  v.push_back({"kernel.radius", R::Report, MapKind::Caustic, &t.kernelRadius});
+  v.push_back({"kernel.spatial_radius", R::Report, MapKind::Caustic, &t.kernelSpatialRadius});
+  v.push_back({"kernel.half_window", R::Report, MapKind::Caustic, &t.kernelHalfWindow});
+  return v;
+}
 
 DamagedStateError::DamagedStateError(const std::string& path, const std::string& what)
     : Error("damaged progressive state: " + path + ": " + what) {}
@@ -90,7 +113,9 @@ void addProgressiveState(ProgressiveState&& state, image::ExrFile& exr) {
   exr.metadata[kAttr + "passes"] = std::to_string(state.passesDone);
   exr.metadata[kAttr + "fingerprint"] = state.fingerprint;
   for (const auto& [name, value] : state.settings) exr.metadata[kAttr + "setting/" + name] = value;
-  for (const auto& [name, value] : state.scalars) exr.metadata[kAttr + "scalar/" + name] = exactDoubleText(value);
+  if (state.pilot.done)
+    for (const ProgressiveScalar& sc : progressiveScalars(state))
+      exr.metadata[kAttr + "scalar/" + sc.name] = exactDoubleText(*sc.value);
 }
 
 std::optional<ProgressiveState> progressiveStateOf(const image::ExrFile& exr, const std::string& path) {
@@ -118,6 +143,10 @@ std::optional<ProgressiveState> progressiveStateOf(const image::ExrFile& exr, co
     state.passesDone = int(n);
   }
   state.fingerprint = need("fingerprint");
+  // The scalars by their names on disk; `state` is ours, so its fields may be written through the table.
+  std::map<std::string, double*> fields;
+  for (const ProgressiveScalar& sc : progressiveScalars(state)) fields[sc.name] = const_cast<double*>(sc.value);
+  size_t found = 0;
   for (const auto& [key, value] : exr.metadata) {
     if (!startsWith(key, kAttr)) continue;
     const std::string name = key.substr(kAttr.size());
@@ -126,9 +155,17 @@ std::optional<ProgressiveState> progressiveStateOf(const image::ExrFile& exr, co
     } else if (startsWith(name, "scalar/")) {
       double v = 0;
       if (!parseExactDouble(value, v)) throw bad(key + " is '" + value + "', not a number");
-      state.scalars[name.substr(7)] = v;
+      auto field = fields.find(name.substr(7));
+      if (field == fields.end()) throw bad(key + " is not a value a progressive render writes");
+      *field->second = v;
+      ++found;
     }
   }
+  // All of them (the pilot is done) or none (pass 0 never ended).
+  state.pilot.done = found > 0;
+  if (found > 0 && found < fields.size())
+    for (const ProgressiveScalar& sc : progressiveScalars(state))
+      if (!exr.metadata.count(kAttr + "scalar/" + sc.name)) throw bad(kAttr + "scalar/" + sc.name + " is missing");
   // The layers hold floats that must come back exactly: a file converted
   // to HALF or to a lossy compression no longer does (issue 27 item 3).
   if (exr.lossyCompression)

@@ -13,10 +13,12 @@
 //      fingerprint  the render's fingerprint (render/fingerprint.h)
 //      layers       the layer names, comma-separated (so a missing one is an error)
 //      setting/NAME the fingerprinted options, as text
-//      scalar/NAME  the exact scalars, as "%.17g" (reads back to the same double)
+//      scalar/NAME  the exact scalars, as "%.17g" (reads back to the same double),
+//                   named by progressiveScalars below (the one table)
 #pragma once
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 #include "image/exr.h"
@@ -27,6 +29,23 @@ namespace tdpm {
 // Prefixes of the state's attribute and channel names.
 inline constexpr const char* kProgressiveAttributePrefix = "tdpm/progressive/";
 inline constexpr const char* kProgressiveLayerPrefix = "progressive.";
+
+// The state's scalars with their names on disk (after "tdpm/progressive/
+// scalar/"): the one mapping from the typed state to the file's names, in
+// a fixed order. Per map kind (render/map_kinds.h name):
+//   Paths   photons.<kind>_paths_per_pass
+//   Kernel  kernel.<kind>.radius_1, kernel.<kind>.half_window_1, kernel.<kind>.spatial_radius_1
+// and once: Total photons.emitted, photons.stored, seconds; Report
+// kernel.radius, kernel.spatial_radius, kernel.half_window. A state whose
+// pilot is done has every one; one whose pilot is not has none.
+enum class ProgressiveScalarRole { Paths, Kernel, Total, Report };
+struct ProgressiveScalar {
+  std::string name;
+  ProgressiveScalarRole role;
+  MapKind kind;  // Paths and Kernel only
+  const double* value;
+};
+std::vector<ProgressiveScalar> progressiveScalars(const ProgressiveState& state);
 
 // Adds `state` to `exr` (channels and attributes as above), replacing any
 // state already there. Every layer must have exr.color's pixel count, and
@@ -48,7 +67,8 @@ struct DamagedStateError : Error {
 // when the file carries none (no "tdpm/progressive/version" attribute).
 // Another layout version throws tdpm::Error "<path>: ...". A state that is
 // there but damaged (an attribute that does not parse, a listed layer
-// missing or unlisted, a layer stored as HALF or UINT, a lossy compression
+// missing or unlisted, a scalar that is not one of progressiveScalars or
+// missing while others are there, a layer stored as HALF or UINT, a lossy compression
 // such as DWAA, DWAB, B44 or PXR24) throws DamagedStateError naming the
 // attribute or layer. Whether the values fit together and fit the render
 // is checkProgressiveState's (render/progressive_check.h).

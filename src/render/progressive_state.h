@@ -12,7 +12,43 @@
 #include <string>
 #include <vector>
 
+#include "render/map_kinds.h"
+
 namespace tdpm {
+
+// What pass 0 fixes for one photon map kind, for every later pass.
+struct ProgressiveMapPilot {
+  // Paths each pass traces (the tracer's pilot in pass 0 chose it): pass i
+  // traces global path indices [i p, (i + 1) p).
+  double pathsPerPass = 0;
+  // Pass 1's kernels from the k-NN pilot on pass 0's photons
+  // (render/progressive.cpp pilotKernel): the space-time radius and half
+  // window, and the spatial radius.
+  double radius = 0, halfWindow = 0, spatialRadius = 0;
+  bool operator==(const ProgressiveMapPilot& o) const {
+    return pathsPerPass == o.pathsPerPass && radius == o.radius && halfWindow == o.halfWindow &&
+           spatialRadius == o.spatialRadius;
+  }
+};
+
+struct ProgressivePilot {
+  bool done = false;  // pass 0 has fixed the values below
+  PerMap<ProgressiveMapPilot> maps;
+  bool operator==(const ProgressivePilot& o) const {
+    if (done != o.done) return false;
+    for (MapKind k : kAllMapKinds)
+      if (!(maps[k] == o.maps[k])) return false;
+    return true;
+  }
+};
+
+// Running totals over the passes done, and the last pass's caustic kernel,
+// for the user (nothing reads them back but the checks).
+struct ProgressiveTotals {
+  double photonsEmitted = 0, photonsStored = 0;
+  double seconds = 0;  // wall clock: differs between runs of the same render
+  double kernelRadius = 0, kernelSpatialRadius = 0, kernelHalfWindow = 0;
+};
 
 struct ProgressiveState {
   // Identifies the render: a hash of the scene as loaded and of every option
@@ -25,13 +61,14 @@ struct ProgressiveState {
   std::map<std::string, std::string> settings;
 
   int passesDone = 0;
-  // Exact scalars the next pass depends on or the user wants reported:
-  // e.g. "photons.emitted", "photons.stored", "seconds", "kernel.radius",
-  // "kernel.half_window". Doubles, stored as "%.17g" strings (exact round trip).
-  std::map<std::string, double> scalars;
+  // Exact values the next pass depends on, and the totals: doubles, stored
+  // as "%.17g" strings (exact round trip) under the names of
+  // render/progressive_io.h's one table (e.g. "kernel.caustic.radius_1").
+  ProgressivePilot pilot;
+  ProgressiveTotals totals;
   // Per-pixel float arrays (width x height, row-major) the image and the
   // next pass depend on: the running sums "sum.R", "sum.G", "sum.B" (the
-  // image is sum / passesDone), "spp", and any per-pixel kernel state.
+  // image is sum / passesDone), "sumsq.*", "spp".
   // Floats, stored as FLOAT EXR layers (exact round trip).
   std::map<std::string, std::vector<float>> layers;
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "estimate/estimators.h"
+#include "render/map_kinds.h"
 #include "sampling/filter.h"
 #include "sampling/sampler.h"
 #include "scene/render_method.h"
@@ -48,7 +49,9 @@ struct RenderOptions {
   size_t guidePhotons = 0;
 
   // ---- photon methods ----
-  size_t causticPhotons = 200000;  // stored photons wanted
+  // Stored photons wanted per map (the kinds' table, render/map_kinds.cpp,
+  // points at these and at their sources below).
+  size_t causticPhotons = 200000;
   size_t globalPhotons = 50000;
   int frames = 8;                  // accumulation: in-between frames
   bool spaceTime4D = false;        // --search 4d
@@ -99,8 +102,8 @@ struct RenderStats {
   double seconds = 0;          // everything: photon passes, trees, rendering
   double photonSeconds = 0;    // tracing + tree builds
   uint64_t cameraSamples = 0;
-  size_t causticStored = 0, globalStored = 0;
-  uint64_t causticEmitted = 0, globalEmitted = 0;
+  // Per photon map (render/map_kinds.h): stored, emitted, k-NN estimates.
+  PerMap<MapStats> maps;
   double bytesPerPhoton = 0;
   // The path tracer's caustic guide (render/caustic_guide.h): photons
   // stored and emitted, its neighbour cache's bytes, seconds to build it all.
@@ -109,9 +112,6 @@ struct RenderStats {
   size_t guideCells = 0, guideCellsFilled = 0;  // its neighbour cache's sub-cells: all, and filled by the render
   double guideSeconds = 0;
   uint64_t standardEstimates = 0, timeEstimates = 0;
-  // k-NN estimates per map, and those from fewer than estimate::kFewPhotons
-  // photons (--stats; 0 for progressive passes, whose kernels are fixed).
-  uint64_t causticEstimates = 0, globalEstimates = 0, fewCausticEstimates = 0, fewGlobalEstimates = 0;
   int minSpp = 0, maxSpp = 0;  // over pixels
   uint64_t peakResidentBytes = 0;  // of the whole process, at the end of render() (core/memory.h)
   std::vector<std::string> warnings;  // for the user: empty photon maps and the like

@@ -238,35 +238,20 @@ float defaultMaxRadius(const Scene& scene, const RenderOptions& opt) {
   return opt.maxRadiusFraction * diag;
 }
 
-struct Maps {
-  std::unique_ptr<PhotonMap> caustic, global;
-};
-
-Maps tracePhotonMaps(const Scene& scene, const RenderOptions& opt, size_t causticWanted, size_t globalWanted,
-                     bool spreadInTime, float fixedTime01, uint64_t seed, const Progress& progress, RenderStats& st,
-                     dist::Comm& comm) {
-  Maps maps;
-  auto settings = [&](photon::MapKind kind, size_t wanted) {
-    PhotonMapSettings ms = photonMapSettingsFor(opt, kind, wanted, seed, spreadInTime, fixedTime01);
-    ms.trace.comm = &comm;
-    ms.spaceTime = opt.spaceTime4D && spreadInTime;
-    ms.kappa = opt.kappa;
-    return ms;
-  };
-  maps.caustic = buildPhotonMap(scene, settings(photon::MapKind::Caustic, causticWanted), progress);
-  maps.global = buildPhotonMap(scene, settings(photon::MapKind::Global, wantsGlobalMap(opt) ? globalWanted : 0), progress);
-  for (const PhotonMap* m : {maps.caustic.get(), maps.global.get()}) {
-    st.photonSeconds += m->traceSeconds + m->buildSeconds;
-    if (!m->warning.empty()) st.warnings.push_back(m->warning);
+// Every map of a fixed-budget render or accumulation frame: `wanted`
+// photons of each kind, the render's communicator, the 4D tree when the
+// photons are spread in time and --search 4d asks for it.
+PhotonMaps tracePhotonMaps(const Scene& scene, const RenderOptions& opt, const PerMap<size_t>& wanted,
+                           bool spreadInTime, float fixedTime01, uint64_t seed, const Progress& progress,
+                           RenderStats& st, dist::Comm& comm) {
+  PerMap<PhotonMapSettings> settings = photonMapSettingsFor(opt, wanted, seed, spreadInTime, fixedTime01);
+  for (MapKind k : kAllMapKinds) {
+    settings[k].trace.comm = &comm;
+    settings[k].spaceTime = opt.spaceTime4D && spreadInTime;
+    settings[k].kappa = opt.kappa;
   }
-  st.causticStored += maps.caustic->size();
-  st.globalStored += maps.global->size();
-  st.causticEmitted += maps.caustic->emitted;
-  st.globalEmitted += maps.global->emitted;
-  size_t n = maps.caustic->size() + maps.global->size();
-  if (n > 0)
-    st.bytesPerPhoton = (maps.caustic->bytesPerPhoton() * double(maps.caustic->size()) +
-                         maps.global->bytesPerPhoton() * double(maps.global->size())) / double(n);
+  PhotonMaps maps = buildPhotonMaps(scene, settings, progress);
+  addMapFigures(st, maps);
   return maps;
 }
 
@@ -316,13 +301,6 @@ PhotonIntegratorSettings integratorSettings(const Scene& scene, const RenderOpti
   return s;
 }
 
-std::string formatBytes(uint64_t b) {
-  char buf[64];
-  if (b >= (uint64_t(1) << 30)) std::snprintf(buf, sizeof buf, "%.2f GiB", double(b) / double(uint64_t(1) << 30));
-  else std::snprintf(buf, sizeof buf, "%.1f MiB", double(b) / double(uint64_t(1) << 20));
-  return std::to_string(b) + " bytes (" + buf + ")";
-}
-
 void finishStats(const Film& film, RenderStats& st) {
   st.cameraSamples = 0;
   st.minSpp = film.sampleCount.empty() ? 0 : int(film.sampleCount[0]);
@@ -335,61 +313,6 @@ void finishStats(const Film& film, RenderStats& st) {
 }
 
 }  // namespace
-
-// Bytes per stored photon, as photon/ holds them (docs/photon-map.md):
-constexpr uint64_t kStoreBytes = 20;        // the store; the kd-tree adds nothing
-// Tracing appends chunks of batches to a store reserved for the expected
-// count (photon/tracer.cpp), then shrinks it to fit: one copy of the store.
-constexpr uint64_t kShrinkBytes = 20;
-// A chunk's per-batch buffers: up to 2x the photons they hold from vector
-// growth, for at most kChunkPaths paths (kBatchesPerChunk x kPathsPerBatch).
-constexpr uint64_t kChunkBytes = 2 * 20;
-constexpr uint64_t kChunkPaths = 256 * 1024;
-constexpr uint64_t kBuild3Bytes = 16 + 5;   // kd-tree builder: 3D keys + index, then permutation + axis
-constexpr uint64_t kBuild4Bytes = 20 + 5;   // 4D keys + index, permutation + axis
-constexpr uint64_t kPilotPaths = 16 * 1024; // photon/tracer.cpp: 16 pilot batches of 1024 paths
-
-uint64_t photonMemoryBytes(size_t caustic, size_t global, bool spaceTime4D, int maxDepth) {
-  // One map: what it keeps, and the most it holds at once while it is made.
-  auto kept = [&](uint64_t n) { return n * kStoreBytes * (spaceTime4D ? 2 : 1); };
-  auto peak = [&](uint64_t n, uint64_t storedPerPilotPath) {
-    if (n == 0) return uint64_t(0);
-    uint64_t chunk = std::min<uint64_t>(n, kChunkPaths * storedPerPilotPath) * kChunkBytes;
-    uint64_t tracing = n * (kStoreBytes + kShrinkBytes) + chunk;
-    // 3D: store + builder. 4D: the 3D copy is kept while the 4D tree is built.
-    uint64_t building = spaceTime4D ? n * (2 * kStoreBytes + kBuild4Bytes) : n * (kStoreBytes + kBuild3Bytes);
-    uint64_t pilot = kPilotPaths * storedPerPilotPath * (kStoreBytes + kChunkBytes);
-    return std::max({tracing, building, pilot});
-  };
-  // A caustic path stores at most one photon; a global path one per bounce.
-  uint64_t causticPeak = peak(caustic, 1);
-  uint64_t globalPeak = peak(global, uint64_t(std::max(1, maxDepth)) + 1);
-  return std::max(causticPeak, kept(caustic) + globalPeak);
-}
-
-uint64_t memoryMarginBytes(uint64_t available) { return (uint64_t(256) << 20) + available / 16; }
-
-void checkPhotonMemory(size_t caustic, size_t global, bool spaceTime4D, int maxDepth, uint64_t available,
-                       const std::string& causticName, const std::string& globalName) {
-  if (available == 0) return;  // unknown: better to try than to refuse
-  uint64_t margin = memoryMarginBytes(available);
-  uint64_t usable = available > margin ? available - margin : 0;
-  uint64_t needed = photonMemoryBytes(caustic, global, spaceTime4D, maxDepth);
-  if (needed <= usable) return;
-  // Blame the count that alone does not fit, else both together.
-  std::string what;
-  if (photonMemoryBytes(caustic, 0, spaceTime4D, maxDepth) > usable)
-    what = causticName + " asks for " + std::to_string(caustic) + " caustic photons";
-  else if (photonMemoryBytes(0, global, spaceTime4D, maxDepth) > usable)
-    what = globalName + " asks for " + std::to_string(global) + " global photons";
-  else
-    what = causticName + " and " + globalName + " ask for " + std::to_string(caustic) + " caustic and " +
-           std::to_string(global) + " global photons";
-  throw Error(what + (spaceTime4D ? " with --search 4d" : "") + ", which need about " + formatBytes(needed) +
-              " while tracing and building the kd-trees, but only " + formatBytes(usable) +
-              " of memory is available (MemAvailable " + formatBytes(available) + " less a margin of " +
-              formatBytes(margin) + "); lower the photon counts");
-}
 
 std::vector<std::string> sceneWarnings(const Scene& scene) {
   std::vector<std::string> w;
@@ -411,12 +334,14 @@ PixelFilter pixelFilterFor(const RenderOptions& opt) {
 }
 
 namespace {
-// The per-map k-NN estimate counts of one integrator into the stats.
-void addMapCounts(RenderStats& st, const EstimateCounts& c) {
-  st.causticEstimates += c.caustic;
-  st.globalEstimates += c.global;
-  st.fewCausticEstimates += c.fewCaustic;
-  st.fewGlobalEstimates += c.fewGlobal;
+// The k-NN estimate counts of one integrator into the stats.
+void addEstimateCounts(RenderStats& st, const EstimateCounts& c) {
+  st.standardEstimates += c.standard;
+  st.timeEstimates += c.timeDependent;
+  for (MapKind k : kAllMapKinds) {
+    st.maps[k].estimates += c.estimates[k];
+    st.maps[k].fewEstimates += c.few[k];
+  }
 }
 
 // pathtrace: the caustic guide, then the adaptive passes.
@@ -433,25 +358,24 @@ void renderPathTraced(const Scene& scene, const RenderOptions& opt, const Sampli
 void renderAccumulation(const Scene& scene, const RenderOptions& opt, const SamplingPlan& plan,
                         const Progress& progress, RenderStats& st, dist::Comm& comm, Film& film) {
   int frames = scene.hasMotion ? std::max(1, opt.frames) : 1;
-  size_t causticPer = (opt.causticPhotons + size_t(frames) - 1) / size_t(frames);
-  size_t globalPer = (opt.globalPhotons + size_t(frames) - 1) / size_t(frames);
+  PerMap<size_t> perFrame = photonsWanted(opt);
+  for (MapKind k : kAllMapKinds) perFrame[k] = (perFrame[k] + size_t(frames) - 1) / size_t(frames);
   SamplingPlan framePlan = plan;
   framePlan.batch = std::max(1, opt.spp / frames);
   framePlan.maxSpp = std::max(framePlan.batch, plan.maxSpp / frames);
   Film sum(film.width, film.height);
   for (int f = 0; f < frames; ++f) {
     float t01 = (float(f) + 0.5f) / float(frames);
-    Maps maps = tracePhotonMaps(scene, opt, causticPer, globalPer, false, t01, hashCombine(opt.seed, uint64_t(f)),
-                                progress, st, comm);
-    PhotonIntegrator integ(scene, maps.caustic.get(), maps.global.get(), integratorSettings(scene, opt, false));
+    PhotonMaps maps =
+        tracePhotonMaps(scene, opt, perFrame, false, t01, hashCombine(opt.seed, uint64_t(f)), progress, st, comm);
+    PhotonIntegrator integ(scene, maps.view(), integratorSettings(scene, opt, false));
     framePlan.camera.times.fixed01 = t01;
     framePlan.seed = hashCombine(opt.seed, 0xacc0ull + uint64_t(f));
     Film one(film.width, film.height);
     std::string stage = "frame " + std::to_string(f + 1) + "/" + std::to_string(frames);
     renderPixels(scene, integ, framePlan, stage.c_str(), progress, one);
     EstimateCounts c = integ.counts();
-    st.standardEstimates += c.standard;
-    addMapCounts(st, c);
+    addEstimateCounts(st, c);
     for (size_t i = 0; i < sum.color.size(); ++i) {
       sum.color[i] += one.color[i];
       sum.sampleCount[i] += one.sampleCount[i];
@@ -474,13 +398,10 @@ void renderPhotonMapped(const Scene& scene, const RenderOptions& opt, const Samp
   const RenderMethodTraits& method = renderMethodTraits(opt.method);
   bool spread = method.spreadsPhotonsInTime && scene.hasMotion;
   bool timeDependent = method.timeDependentEstimate && scene.hasMotion;
-  Maps maps = tracePhotonMaps(scene, opt, opt.causticPhotons, opt.globalPhotons, spread, 0.0f, opt.seed, progress, st, comm);
-  PhotonIntegrator integ(scene, maps.caustic.get(), maps.global.get(), integratorSettings(scene, opt, timeDependent));
+  PhotonMaps maps = tracePhotonMaps(scene, opt, photonsWanted(opt), spread, 0.0f, opt.seed, progress, st, comm);
+  PhotonIntegrator integ(scene, maps.view(), integratorSettings(scene, opt, timeDependent));
   renderPixels(scene, integ, plan, "render", progress, film);
-  EstimateCounts c = integ.counts();
-  st.standardEstimates = c.standard;
-  st.timeEstimates = c.timeDependent;
-  addMapCounts(st, c);
+  addEstimateCounts(st, integ.counts());
 }
 
 // Distributed: rank 0 gathers the film from the tiles' owners; estimate
@@ -491,15 +412,18 @@ void gatherFilm(dist::Comm& comm, TileOwners& owners, RenderStats& st, Film& fil
   sharePixels(comm, film.width, film.height, film.color, false, owners);
   sharePixels(comm, film.width, film.height, film.sampleCount, false, owners);
   sharePixels(comm, film.width, film.height, film.varianceOfMean, false, owners);
-  uint64_t counts[6] = {st.standardEstimates, st.timeEstimates, st.causticEstimates,
-                        st.globalEstimates, st.fewCausticEstimates, st.fewGlobalEstimates};
-  comm.allreduceSum(counts, 6);
+  std::vector<uint64_t> counts{st.standardEstimates, st.timeEstimates};
+  for (MapKind k : kAllMapKinds) {
+    counts.push_back(st.maps[k].estimates);
+    counts.push_back(st.maps[k].fewEstimates);
+  }
+  comm.allreduceSum(counts.data(), counts.size());
   st.standardEstimates = counts[0];
   st.timeEstimates = counts[1];
-  st.causticEstimates = counts[2];
-  st.globalEstimates = counts[3];
-  st.fewCausticEstimates = counts[4];
-  st.fewGlobalEstimates = counts[5];
+  for (MapKind k : kAllMapKinds) {
+    st.maps[k].estimates = counts[2 + 2 * size_t(k)];
+    st.maps[k].fewEstimates = counts[3 + 2 * size_t(k)];
+  }
 }
 
 }  // namespace
@@ -557,12 +481,9 @@ Film renderFrame(const Scene& scene, const RenderOptions& opt, const FrameInput&
     PhotonIntegratorSettings s = integratorSettings(scene, opt, renderMethodTraits(opt.method).timeDependentEstimate && scene.hasMotion);
     if (!std::isfinite(opt.estimate.maxTimeDistance))
       s.estimate.maxTimeDistance = opt.maxDtFraction * frame.shutter.length();
-    PhotonIntegrator integ(scene, frame.caustic, frame.global, s);
+    PhotonIntegrator integ(scene, frame.maps, s);
     renderPixels(scene, integ, plan, "render", progress, film);
-    EstimateCounts c = integ.counts();
-    st.standardEstimates = c.standard;
-    st.timeEstimates = c.timeDependent;
-    addMapCounts(st, c);
+    addEstimateCounts(st, integ.counts());
   }
   finishStats(film, st);
   st.seconds = timer.seconds();

@@ -12,6 +12,7 @@
 #include "estimate/estimators.h"
 #include "motion/shutter.h"
 #include "render/film.h"
+#include "render/map_kinds.h"
 #include "render/render_options.h"
 #include "sampling/filter.h"
 #include "sampling/sampler.h"
@@ -58,28 +59,9 @@ Film render(const Scene& scene, const RenderOptions& options, const Progress& pr
 // progressive renderer with the same input.
 struct FrameInput {
   Shutter shutter;
-  const PhotonMap* caustic = nullptr;
-  const PhotonMap* global = nullptr;
+  PerMap<const PhotonMap*> maps;  // null for the path tracer
 };
 Film renderFrame(const Scene& scene, const RenderOptions& options, const FrameInput& frame, const Progress& progress,
                  RenderStats& stats);
-
-// ---- photon memory budget ----
-// Peak bytes the photon passes hold for maps of `caustic` and `global`
-// stored photons (the global map is traced while the caustic map is held):
-// 20 bytes per stored photon, a second 3D-ordered copy for the 4D search,
-// and the transients: the per-batch buffers while tracing (up to 2x their
-// size from vector growth, alive until they are concatenated) or the
-// kd-tree builder's keys and permutation, plus the pilot run.
-uint64_t photonMemoryBytes(size_t caustic, size_t global, bool spaceTime4D, int maxDepth);
-// Memory kept back from MemAvailable for everything that is not photons
-// (scene, film, threads, other processes' growth).
-uint64_t memoryMarginBytes(uint64_t available);
-// Throws tdpm::Error naming `causticName` and/or `globalName` (the flag or
-// scene key that set each count), the bytes needed and the bytes available
-// when photonMemoryBytes(...) > available - margin. available == 0 means
-// unknown (no /proc): no check.
-void checkPhotonMemory(size_t caustic, size_t global, bool spaceTime4D, int maxDepth, uint64_t available,
-                       const std::string& causticName, const std::string& globalName);
 
 }  // namespace tdpm

@@ -90,7 +90,7 @@ std::vector<float> pilotNoise(const Scene& scene, const RenderOptions& opt, cons
   is.timeDependent = false;
   is.gatherRays = 0;
   is.maxDepth = opt.maxDepth;
-  PhotonIntegrator eyeOnly(scene, nullptr, nullptr, is);
+  PhotonIntegrator eyeOnly(scene, {}, is);
   CameraSamplePlan plan{pixelFilterFor(opt), {}};
   plan.times.moving = scene.hasMotion;
   setFrameTimes(plan.times, scene.shutter, opt.frameOpen, opt.frameClose);  // an animation frame's passes
