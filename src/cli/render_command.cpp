@@ -381,7 +381,8 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_option("--gather-guide", a.gatherGuide,
                 "Fixed budget: share of the final-gather rays aimed along the incoming directions of the 32 global "
                 "photons nearest the gather point (Jensen 1995; an unbiased mixture with the BSDF: a bright patch "
-                "no longer salts the image); 0 turns it off (default 0.5; docs/photon-map.md)")
+                "no longer salts the image); no cone toward a light; not used under a non-black background, whose light has "
+                "no photons; 0 turns it off (default 0.5; docs/photon-map.md)")
       ->check(rangeOf(limits::kGatherGuide))->group(photonGroup);
   c->add_flag("--global-direct", a.globalDirect, "Show the global photon map directly at the first diffuse hit (debugging, tests)")
       ->group(photonGroup);
