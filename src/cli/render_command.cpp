@@ -382,7 +382,9 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
                 "Fixed budget: share of the final-gather rays aimed along the incoming directions of the 32 global "
                 "photons nearest the gather point (Jensen 1995; an unbiased mixture with the BSDF: a bright patch "
                 "no longer salts the image); no cone toward a light; not used under a non-black background, whose light has "
-                "no photons; 0 turns it off (default 0.5; docs/photon-map.md)")
+                "no photons. Helps where a small bright patch lights a large room (sparse-room: salt 0.82% -> 0.03%); "
+                "doubles the noise of an evenly lit small room (static-room); default 0 (off), 0.5 where it helps "
+                "(docs/photon-map.md)")
       ->check(rangeOf(limits::kGatherGuide))->group(photonGroup);
   c->add_flag("--global-direct", a.globalDirect, "Show the global photon map directly at the first diffuse hit (debugging, tests)")
       ->group(photonGroup);

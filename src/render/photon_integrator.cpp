@@ -119,11 +119,6 @@ Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::G
   return L;
 }
 
-// The gather guide at a gather point: the global photons nearest it that
-// arrived on its side give the directions its indirect light comes from in
-// proportion to their flux (Jensen 1995, "Importance driven path tracing
-// using the photon map"). Unbiased whatever they hold: the mixture with the
-// BSDF covers every direction (render/guided_sampling.h).
 // True if direction w from p points at a light (see kTowardLightCos).
 bool PhotonIntegrator::towardLight(Vec3f p, Vec3f w, float time01) const {
   for (const Light& light : scene_.lights) {
@@ -145,6 +140,11 @@ bool PhotonIntegrator::towardLight(Vec3f p, Vec3f w, float time01) const {
   return false;
 }
 
+// The gather guide at a gather point: the global photons nearest it that
+// arrived on its side give the directions its indirect light comes from in
+// proportion to their flux (Jensen 1995, "Importance driven path tracing
+// using the photon map"). Unbiased whatever they hold: the mixture with the
+// BSDF covers every direction (render/guided_sampling.h).
 void PhotonIntegrator::gatherCones(const Hit& hit, const ShadingContext& ctx, float time01, ThreadState& ts,
                                    GuideCones& cones) const {
   cones = GuideCones{};
