@@ -86,6 +86,7 @@ std::map<std::string, std::string> renderSettings(const RenderOptions& o, int wi
       {"cone_k", floatText(e.coneK)},
       {"min_radius2", floatText(e.minRadius2)},
       {"gather", std::to_string(o.gatherRays)},
+      {"gather_guide", floatText(o.gatherGuide)},
       {"global_direct", o.visualizeGlobal ? "yes" : "no"},
       {"resolution", std::to_string(width) + "x" + std::to_string(height)},
       {"filter", filterName(o.filter)},

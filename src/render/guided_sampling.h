@@ -24,7 +24,7 @@
 namespace tdpm {
 
 struct GuideCones {
-  static constexpr int kMaxCones = 16;
+  static constexpr int kMaxCones = 32;
   // A cone is tested by chord length, |w - axis|^2 <= 2 (1 - cos theta_max),
   // not by the cosine: for the sub-degree cones of a focused caustic
   // 1 - cos is ~1e-5, and a float dot product near 1 would misjudge the

@@ -7,6 +7,7 @@
 
 #include "photon/surface_tag.h"
 #include "render/direct_light.h"
+#include "render/guided_sampling.h"
 #include "scene/bsdf.h"
 
 namespace tdpm {
@@ -15,6 +16,24 @@ namespace {
 constexpr int kGatherSpecularBounces = 4;  // a gather ray may pass this many mirrors/glass/sharp metals
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kSplitGlassVertices = 2;  // traceFrom
+// The gather guide's cones: the GuideCones::kMaxCones (32) global photons
+// nearest the gather point, one cone each around its incoming direction, of
+// half-angle 0.2 rad (11.5 degrees: wider than the photons' 1.2-degree
+// encoding error and than the spread of directions toward a bright patch a
+// few metres away across one estimate's disc). Measured on
+// scenes/sparse-room.json (docs/photon-map.md): 16 photons / 0.15 rad left
+// 2x the salt of 32 / 0.2; 0.08 rad 4x; 0.3 rad more relMSE.
+constexpr float kGatherConeOneMinusCos = 0.019933f;  // 1 - cos(0.2)
+// A guide photon whose direction meets an area light, or is within 0.05 rad
+// of a delta light's direction, most likely came straight from it: its cone
+// would find only the light, whose direct light the shadow rays already
+// carry (or nothing: a delta light cannot be hit), so it gives no cone. Not
+// widened for area lights: the bright wall right beside a lamp is what the
+// cones must find (a 0.1-rad margin doubled sparse-room's relMSE). Only in
+// scenes with at most kGuideLightTests lights (the test is per light and
+// photon).
+constexpr float kTowardLightCos = 0.99875f;  // cos(0.05)
+constexpr size_t kGuideLightTests = 8;
 }  // namespace
 
 PhotonIntegrator::PhotonIntegrator(const Scene& scene, const PerMap<const PhotonMap*>& maps,
@@ -98,14 +117,63 @@ Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::G
   return L;
 }
 
+// True if direction w from p points at a light (see kTowardLightCos).
+bool PhotonIntegrator::towardLight(Vec3f p, Vec3f w, float time01) const {
+  for (const Light& light : scene_.lights) {
+    if (light.type == Light::Type::Environment) continue;
+    if (light.isDelta()) {
+      LightSample ls;
+      if (sampleLight(light, p, time01, {0.5f, 0.5f}, ls) && dot(ls.wi, w) > kTowardLightCos) return true;
+      continue;
+    }
+    AreaLightFrame f = areaLightFrame(light, time01);
+    float den = dot(w, f.normal);
+    if (!(den < 0.0f)) continue;  // not toward its emitting side
+    float t = dot(f.center - p, f.normal) / den;
+    if (!(t > 0.0f)) continue;
+    Vec3f q = p + w * t - f.center;
+    if (std::fabs(dot(q, f.edgeX)) <= 0.5f * dot(f.edgeX, f.edgeX) && std::fabs(dot(q, f.edgeZ)) <= 0.5f * dot(f.edgeZ, f.edgeZ))
+      return true;
+  }
+  return false;
+}
+
+// The gather guide at a gather point: the global photons nearest it that
+// arrived on its side give the directions its indirect light comes from in
+// proportion to their flux (Jensen 1995, "Importance driven path tracing
+// using the photon map"). Unbiased whatever they hold: the mixture with the
+// BSDF covers every direction (render/guided_sampling.h).
+void PhotonIntegrator::gatherCones(const Hit& hit, const ShadingContext& ctx, float time01, ThreadState& ts,
+                                   GuideCones& cones) const {
+  cones = GuideCones{};
+  // A non-black background lights the scene without photons: the guide
+  // would take rays from it (truck-laser's sky: relMSE x2), so none there.
+  if (!(s_.gatherGuide > 0.0f) || !global_ || global_->size() == 0 || !scene_.background.isBlack()) return;
+  const photon::KdTree& tree = global_->spatialTree();
+  float maxR2 = s_.estimate.maxRadius * s_.estimate.maxRadius;
+  int found = tree.knn(hit.p, GuideCones::kMaxCones, maxR2, ts.guideQuery);
+  const photon::PhotonStore& st = tree.store();
+  const uint32_t* idx = ts.guideQuery.index();
+  const float solidAngle = 2.0f * kPi * kGatherConeOneMinusCos;
+  const bool testLights = scene_.lights.size() <= kGuideLightTests;
+  for (int i = 0; i < found; ++i) {
+    Vec3f w = st.direction(idx[i]);
+    if (!(dot(w, ctx.frame.n) > 0.0f)) continue;
+    if (testLights && towardLight(hit.p, w, time01)) continue;
+    cones.cone[size_t(cones.count++)] = {w, kGatherConeOneMinusCos, solidAngle};
+    cones.totalSolidAngle += solidAngle;
+  }
+  if (cones.count > 0) cones.fraction = s_.gatherGuide;
+}
+
 template <class Stream>
 Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, float time01, bool touched,
-                                  Stream& sampler, int vertex, ThreadState& ts) const {
+                                  Stream& sampler, int vertex, ThreadState& ts, const GuideCones& cones) const {
   Rgb sum(0.0f);
   for (int i = 0; i < s_.gatherRays; ++i) {
     BsdfSample bs;
     Vec3f u = sampler.get3D(dims::vertexGroup(vertex, dims::kGather, uint32_t(i)));
-    if (!bsdfSample(ctx, {u.x, u.y}, u.z, Transport::Radiance, bs)) continue;
+    if (!guidedBsdfSample(ctx, cones, {u.x, u.y}, u.z, bs)) continue;
     Rgb beta = bs.weight;
     Vec3f o = scene_.spawnOrigin(hit.p, hit.n, bs.wi), d = bs.wi;
     bool moved = touched;
@@ -273,10 +341,14 @@ Rgb PhotonIntegrator::traceFrom(Vec3f origin, Vec3f dir, float time01, EyeVertex
         break;
       }
       bool gather = global_ && global_->size() > 0 && s_.gatherRays > 0;
-      addEye(beta * directLight(scene_, hit, ctx, time01, sampler, depth, gather ? s_.gatherRays : 0));
+      // The gather guide changes the gather rays' density, which the direct
+      // light's MIS weights must use too.
+      GuideCones cones;
+      if (gather) gatherCones(hit, ctx, time01, ts, cones);
+      addEye(beta * directLight(scene_, hit, ctx, time01, sampler, depth, gather ? s_.gatherRays : 0, &cones));
       if constexpr (kPart == Part::EyeOnly) break;
       L += beta * estimate(caustic_, ts.caustic, ts.caustic3, hit, ctx, -dir, time01, timeDependent, ts, minVolume);
-      if (gather) L += beta * finalGather(hit, ctx, time01, touched, sampler, depth, ts);
+      if (gather) L += beta * finalGather(hit, ctx, time01, touched, sampler, depth, ts, cones);
       break;
     }
 

@@ -31,6 +31,10 @@ struct PhotonIntegratorSettings {
   bool spaceTime4D = false;       // --search 4d
   estimate::Options estimate;     // k, ks, fraction, radii, kernels (method set per query)
   int gatherRays = 1;             // final-gather rays per eye sample
+  // Share of the gather rays drawn toward the incoming directions of the
+  // global photons nearest the gather point (Jensen 1995), mixed with BSDF
+  // sampling (render/guided_sampling.h); 0: BSDF sampling alone.
+  float gatherGuide = 0.0f;
   bool visualizeGlobal = false;   // gather point = global-map estimate alone (no direct, no gather)
   int maxDepth = 16;
   // Time-dependent two-pass caustic estimates seen from the camera: the
@@ -54,12 +58,15 @@ struct EstimateCounts {
   PerMap<uint64_t> estimates, few;
 };
 
+struct GuideCones;  // render/guided_sampling.h
+
 class PhotonIntegrator {
  public:
   struct ThreadState {
     std::unique_ptr<estimate::Gatherer> caustic, caustic3, global, global3;
     std::unique_ptr<estimate::FixedKernelGatherer> fixed;  // fixedKernels only
     EstimateCounts counts;
+    photon::KnnQuery guideQuery;  // the gather guide's photons (gatherGuide > 0)
   };
 
   // The maps by kind (PhotonMaps::view(), render/photon_map.h); null or
@@ -113,7 +120,10 @@ class PhotonIntegrator {
                 Rgb* eye) const;
   template <class Stream>
   Rgb finalGather(const Hit& hit, const struct ShadingContext& ctx, float time01, bool touched, Stream& sampler,
-                  int vertex, ThreadState& ts) const;
+                  int vertex, ThreadState& ts, const GuideCones& cones) const;
+  void gatherCones(const Hit& hit, const struct ShadingContext& ctx, float time01, ThreadState& ts,
+                   GuideCones& cones) const;
+  bool towardLight(Vec3f p, Vec3f w, float time01) const;
 
   const Scene& scene_;
   const PhotonMap* caustic_;

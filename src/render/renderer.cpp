@@ -296,6 +296,7 @@ PhotonIntegratorSettings integratorSettings(const Scene& scene, const RenderOpti
   float pixelAngle = length(cross(d0, d1)) / (length(d0) * length(d1));
   s.footprintVolume = opt.kernelFootprint * pixelAngle * pixelAngle * scene.shutter.length() / float(std::max(1, opt.spp));
   s.gatherRays = opt.gatherRays;
+  s.gatherGuide = opt.gatherGuide;
   s.visualizeGlobal = opt.visualizeGlobal;
   s.maxDepth = opt.maxDepth;
   return s;
