@@ -243,9 +243,14 @@ TEST_CASE("mpi: rank 0 alone prints the summary; --stats gives every rank's comm
   CHECK(occurrences(r.output, "  rank 0: ") == 1);
   CHECK(occurrences(r.output, "  rank 1: ") == 1);
   // Rank 1 sends its photons (20 bytes each) and its tiles: not nothing.
+  // Batches of paths come from a queue the ranks share, so how many rank 1
+  // traces depends on the load of the machine (24,080 bytes were seen on a
+  // busy one, against ~30,000 for an even split): ask for a tenth of the
+  // caustic photons' bytes, far above the few hundred bytes of a rank that
+  // sends only its counters.
   size_t at = r.output.find("  rank 1: ");
   REQUIRE(at != std::string::npos);
-  CHECK(std::strtoull(r.output.c_str() + at + 10, nullptr, 10) > 3000 * 20 / 2);
+  CHECK(std::strtoull(r.output.c_str() + at + 10, nullptr, 10) > 3000 * 20 / 10);
   std::system(("rm -rf '" + dir + "'").c_str());
 }
 
