@@ -86,7 +86,6 @@ std::map<std::string, std::string> renderSettings(const RenderOptions& o, int wi
       {"cone_k", floatText(e.coneK)},
       {"min_radius2", floatText(e.minRadius2)},
       {"gather", std::to_string(o.gatherRays)},
-      {"gather_guide", floatText(o.gatherGuide)},
       {"global_direct", o.visualizeGlobal ? "yes" : "no"},
       {"resolution", std::to_string(width) + "x" + std::to_string(height)},
       {"filter", filterName(o.filter)},
@@ -102,6 +101,7 @@ std::map<std::string, std::string> renderSettings(const RenderOptions& o, int wi
   if (o.passExtraSamples > 0 && o.passSampleCap > 1)
     s["extra_samples"] = floatText(o.passExtraSamples) + " (cap " + std::to_string(o.passSampleCap) + ")";
   if (o.directOnly) s["direct_only"] = "yes";  // likewise: only when on
+  if (o.gatherGuide > 0) s["gather_guide"] = floatText(o.gatherGuide);  // likewise: states made before it resume
   return s;
 }
 
