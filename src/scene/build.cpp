@@ -158,7 +158,8 @@ void classifyTexturedRoughness(Material& m, const scene::MaterialDesc& d, const 
   if (aLo > aHi) std::swap(aLo, aHi);
   if (!(lo >= 0) || !(aHi <= 1))
     throw Error("material \"" + d.name + "\": its roughness texture's values [" + std::to_string(lo) + ", " +
-                std::to_string(hi) + "] give GGX alphas outside [0, 1]");
+                std::to_string(hi) + "] give GGX alphas [" + std::to_string(aLo) + ", " + std::to_string(aHi) +
+                "], outside the [0, 1] tdpm supports");
   using T = Material::Type;
   if (aHi < kSmoothAlpha && (m.type == T::Conductor || m.type == T::RoughDielectric)) {
     m.roughnessTexture = -1;  // smooth everywhere: as a constant roughness 0
