@@ -566,6 +566,11 @@ Material "conductor" "texture reflectance" "refl" "texture roughness" "r"
 Shape "bilinearmesh" "point3 P" [-1 0 -1 1 0 -1 -1 0 1 1 0 1] "point2 uv" [0 0 1 0 0 1 1 1]
 AttributeEnd
 AttributeBegin
+Translate -3 0 0
+Material "coatedconductor" "texture conductor.roughness" "r" "texture interface.roughness" "r"
+Shape "bilinearmesh" "point3 P" [-1 0 -1 1 0 -1 -1 0 1 1 0 1] "point2 uv" [0 0 1 0 0 1 1 1]
+AttributeEnd
+AttributeBegin
 Translate 0 0.4 0
 Material "substrate" "texture Ks" "ks" "texture vroughness" "r" "texture uroughness" "r"
 Shape "sphere" "float radius" 0.3
@@ -574,7 +579,7 @@ AttributeEnd
   test::writeFile(dir + "/s.pbrt", text);
   pbrt::ImportResult r = pbrt::importPbrtFile(dir + "/s.pbrt");
   scene::SceneDescription& d = r.scene;
-  REQUIRE(d.materials.size() == 3);
+  REQUIRE(d.materials.size() == 4);
   auto s = Scene::build(d);
   Material uber = pbrtBelow(*s, -0.5f, -0.5f);  // u < 1/2, v > 1/2 (v runs against z)
   checkRgb(uber.specular, Rgb(0.1f, 0.2f, 0.3f));
@@ -588,6 +593,11 @@ AttributeEnd
     float ri = Rgb(0.9f, 0.5f, 0.2f)[i];
     CHECK(cond.k[i] == doctest::Approx(2 * std::sqrt(ri) / std::sqrt(1 - ri)).epsilon(1e-5));
   }
+  // The coated conductor: both roughnesses per hit, pbrt-v4's sqrt (v = 3/4: tex2 = 0.3).
+  Material coated = pbrtBelow(*s, -3.5f, 0.5f);
+  CHECK(coated.baseAlpha == doctest::Approx(std::sqrt(0.3f)).epsilon(1e-6));
+  CHECK(coated.alpha == doctest::Approx(std::sqrt(0.3f)).epsilon(1e-6));
+  CHECK(pbrtBelow(*s, -3.5f, -0.5f).baseAlpha == doctest::Approx(0.2f).epsilon(1e-6));
   // The round trip: the JSON names the textures and renders the same pixels.
   std::string json = dir + "/s.json";
   pbrt::writeSceneJson(d, json);
@@ -598,6 +608,7 @@ AttributeEnd
   CHECK(contains(written, "\"roughness_remap\": \"pbrt-v3\""));
   CHECK(contains(written, "\"specular\": \"ks\""));
   CHECK(contains(written, "\"color\": \"refl\""));
+  CHECK(contains(written, "\"conductor_roughness\": \"r\""));
   scene::SceneDescription back = scene::loadScene(json);
   CHECK(nlohmann::json::parse(pbrt::sceneToJson(back, "/x/s.json").json) ==
         nlohmann::json::parse(pbrt::sceneToJson(d, "/x/s.json").json));
@@ -638,8 +649,10 @@ TEST_CASE("textured material parameters: bad input gets located errors") {
   CHECK(contains(pbrtError(defs + "Material \"conductor\" \"texture roughness\" \"s\"\n"),
                  "t.pbrt:4: Material \"conductor\": parameter \"texture roughness\": texture \"s\" is a spectrum texture, but a "
                  "roughness needs a float one"));
-  CHECK(contains(pbrtError(defs + "Material \"coatedconductor\" \"texture conductor.roughness\" \"f\"\n"),
-                 "a textured conductor.roughness is not supported here"));
+  CHECK(contains(pbrtError(defs + "Material \"coatedconductor\" \"texture conductor.roughness\" \"s\"\n"),
+                 "texture \"s\" is a spectrum texture, but a roughness needs a float one"));
+  CHECK(contains(pbrtError(defs + "Material \"coatedconductor\" \"texture reflectance\" \"s\"\n"),
+                 "a textured reflectance under a coating is not supported"));
   CHECK(contains(pbrtError(defs + "Material \"conductor\" \"texture uroughness\" \"f\" \"float vroughness\" 0.1\n"),
                  "anisotropic roughness"));
   CHECK(contains(pbrtError(defs + "Material \"uber\" \"texture Ks\" \"f\"\n"), "is a float texture, but a reflectance needs a spectrum one"));

@@ -59,8 +59,7 @@ double Importer::floatParam(const ParamSet& ps, const std::string& name, double 
     p->used = true;
     auto it = p->strings.size() == 1 ? textures_.find(p->strings[0]) : textures_.end();
     if (it == textures_.end() || !it->second.isFloat) ps.fail(*p, "expected a float texture");
-    if (!it->second.constant) ps.fail(*p, "a float texture that varies is supported only as a roughness (not on the coated conductor's "
-                  "conductor.roughness); here only a constant one is");
+    if (!it->second.constant) ps.fail(*p, "a float texture that varies is supported only as a roughness; here only a constant one is");
     return it->second.value.r;
   }
   if (p->type == "spectrum") return spectrumFloat(ps, *p);  // v4: a spectral eta (a constant, a named glass, ...)
@@ -240,10 +239,9 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
       failAt(at, label + ": anisotropic roughness (" + pre + "uroughness and " + pre + "vroughness not the same texture) is not supported");
     return u;
   };
-  // texture: where a textured roughness goes (nullptr: refused here).
-  auto roughnessPre = [&](const std::string& pre, bool v3, double fallback, double* alpha, int32_t* texture = nullptr) {
+  // texture: where a textured roughness goes.
+  auto roughnessPre = [&](const std::string& pre, bool v3, double fallback, double* alpha, int32_t* texture) {
     if (int32_t t = varyingRoughness(pre); t >= 0) {
-      if (!texture) failAt(at, label + ": a textured " + pre + "roughness is not supported here (only a constant one)");
       *texture = t;
       using R = scene::MaterialDesc::Remap;
       m.roughnessRemap = !ps.getBool("remaproughness", true) ? R::None : v3 ? R::PbrtV3 : R::PbrtV4;
@@ -387,7 +385,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
       m.type = T::CoatedConductor;
       conductorIor(false, "conductor.", &m.eta, &m.k);
       double base;
-      roughnessPre("conductor.", false, 0.0, &base);
+      roughnessPre("conductor.", false, 0.0, &base, &m.baseRoughnessTexture);
       m.baseRoughness = float(std::max(base, 1e-3));
     }
     m.thickness = float(floatParam(ps, "thickness", 0.01));

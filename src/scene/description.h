@@ -110,6 +110,7 @@ struct MaterialDesc {
   // SceneDescription::textures) for `roughness` when >= 0, remapped per hit
   // (pbrt's remaproughness: none, pbrt-v3's polynomial, pbrt-v4's sqrt).
   int32_t roughnessTexture = -1;
+  int32_t baseRoughnessTexture = -1;  // coated conductor: a float texture for baseRoughness, same remap
   enum class Remap { None, PbrtV3, PbrtV4 };
   Remap roughnessRemap = Remap::None;
 };

@@ -159,12 +159,10 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
   };
   Json spec = m.specularTexture >= 0 ? Json(textures.at(size_t(m.specularTexture))) : rgb(m.specular);
   // A textured roughness: the texture's name and its remap (parse.cpp).
-  auto rough = [&]() -> Json {
-    if (m.roughnessTexture < 0) return num(m.roughness);
-    using R = scene::MaterialDesc::Remap;
-    if (m.roughnessRemap != R::None) j["roughness_remap"] = m.roughnessRemap == R::PbrtV3 ? "pbrt-v3" : "pbrt-v4";
-    return textures.at(size_t(m.roughnessTexture));
-  };
+  using R = scene::MaterialDesc::Remap;
+  if ((m.roughnessTexture >= 0 || m.baseRoughnessTexture >= 0) && m.roughnessRemap != R::None)
+    j["roughness_remap"] = m.roughnessRemap == R::PbrtV3 ? "pbrt-v3" : "pbrt-v4";
+  auto rough = [&]() -> Json { return m.roughnessTexture < 0 ? Json(num(m.roughness)) : Json(textures.at(size_t(m.roughnessTexture))); };
   switch (m.type) {
     case T::Diffuse: j["type"] = "diffuse"; albedo(); break;
     case T::Mirror: j["type"] = "mirror"; j["color"] = spec; break;
@@ -213,7 +211,8 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
       j["roughness"] = rough();
       j["eta"] = rgb(m.eta);
       j["k"] = rgb(m.k);
-      j["conductor_roughness"] = num(m.baseRoughness);
+      j["conductor_roughness"] =
+          m.baseRoughnessTexture < 0 ? Json(num(m.baseRoughness)) : Json(textures.at(size_t(m.baseRoughnessTexture)));
       j["thickness"] = num(m.thickness);
       break;
     case T::Mix:

@@ -80,6 +80,7 @@ struct Material {
   // (scene/build.cpp, docs/scene-format.md), so isGlossy / isDeltaOnly stay
   // fixed per material.
   int32_t roughnessTexture = -1;
+  int32_t baseRoughnessTexture = -1;  // coated conductor: baseAlpha per hit, as roughnessTexture
   RoughnessRemap roughnessRemap = RoughnessRemap::None;
 
   // Purely delta (mirror, glass, smooth conductor): no photon is stored

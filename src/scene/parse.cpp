@@ -710,13 +710,17 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader*
   } else if (n.has("roughness")) {
     m.roughness = pbrtKind ? readRoughnessOrZero(n.member("roughness")) : readRoughness(n.member("roughness"));
   }
+  if (n.has("conductor_roughness") && n.member("conductor_roughness").json().is_string())
+    m.baseRoughnessTexture = namedTextureIndex(n.member("conductor_roughness"), textures, true);
+  else if (n.has("conductor_roughness"))
+    m.baseRoughness = readRoughnessOrZero(n.member("conductor_roughness"));
   if (n.has("roughness_remap")) {
     Node r = n.member("roughness_remap");
     std::string v = r.choice({"none", "pbrt-v3", "pbrt-v4"}, "roughness_remap");
-    r.require(m.roughnessTexture >= 0, "roughness_remap applies only to a textured roughness (a constant one is the GGX alpha)");
+    r.require(m.roughnessTexture >= 0 || m.baseRoughnessTexture >= 0,
+              "roughness_remap applies only to a textured roughness (a constant one is the GGX alpha)");
     m.roughnessRemap = v == "pbrt-v3" ? MaterialDesc::Remap::PbrtV3 : v == "pbrt-v4" ? MaterialDesc::Remap::PbrtV4 : MaterialDesc::Remap::None;
   }
-  if (n.has("conductor_roughness")) m.baseRoughness = readRoughnessOrZero(n.member("conductor_roughness"));
   if (n.has("thickness")) {
     m.thickness = n.member("thickness").number();
     n.member("thickness").require(m.thickness >= 0 && std::isfinite(m.thickness), "thickness must be non-negative, got " + fmt(m.thickness));

@@ -146,6 +146,10 @@ const Material& Scene::shadeTextured(const Material& m, const Hit& hit, std::opt
     float x = textures.eval(uint32_t(m.roughnessTexture), tp).r;
     scratch->alpha = std::clamp(roughnessToAlpha(x, m.roughnessRemap), 1e-3f, 1.0f);
   }
+  if (m.baseRoughnessTexture >= 0) {
+    float x = textures.eval(uint32_t(m.baseRoughnessTexture), tp).r;
+    scratch->baseAlpha = std::clamp(roughnessToAlpha(x, m.roughnessRemap), 1e-3f, 1.0f);
+  }
   return *scratch;
 }
 

@@ -76,7 +76,7 @@ class Scene {
   // delta lobe on a material classified non-delta). An empty optional costs
   // an untextured hit nothing.
   const Material& shadedMaterial(const Material& m, const Hit& hit, std::optional<Material>& scratch) const {
-    if (m.specularTexture < 0 && m.roughnessTexture < 0) return m;
+    if (m.specularTexture < 0 && m.roughnessTexture < 0 && m.baseRoughnessTexture < 0) return m;
     return shadeTextured(m, hit, scratch);
   }
   // The raw ray tracer (benchmarks compare our tracing against it).
