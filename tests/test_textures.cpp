@@ -428,3 +428,234 @@ TEST_CASE("pbrt uv: a rotated sphere keeps pbrt's (u, v) at its object-space poi
   }
   std::filesystem::remove_all(dir);
 }
+
+// ------------------------------------------------ textured roughness, Ks, conductor reflectance
+
+namespace {
+
+// A 2 x 2 m plane seen from above, under a directional light from the side:
+// a GGX highlight whose shape depends on the roughness. `rough` is the
+// metal's "roughness" value (a number or a texture's name).
+std::string metalPlane(const std::string& textures, const std::string& rough, const std::string& extra = "") {
+  return sceneText(R"("textures": {)" + textures + R"(},
+    "materials": {"m": {"type": "metal", "color": [0.9, 0.8, 0.7], "roughness": )" + rough + extra + R"(}},
+    "objects": [{"shape": {"type": "quad", "size": [2, 2]}, "material": "m"}],
+    "lights": [{"type": "directional", "direction": [-0.3, -1, 0.2], "irradiance": [3, 3, 3]}])");
+}
+
+// The per-hit material straight below (x, z): Scene::shadedMaterial's copy.
+Material shadedBelow(const Scene& s, float x, float z) {
+  Hit h;
+  REQUIRE(s.intersect({x, 3, z}, {0, -1, 0}, 100.0f, 0.0f, h));
+  std::optional<Material> scratch;
+  return s.shadedMaterial(s.materials[s.objects[h.object].material], h, scratch);
+}
+
+// The same in a pbrt scene's coordinates: the importer mirrors x (pbrt's
+// camera frame is left-handed, pbrt_import.cpp).
+Material pbrtBelow(const Scene& s, float x, float z) { return shadedBelow(s, -x, z); }
+
+}  // namespace
+
+TEST_CASE("textured roughness: a checkerboard on a metal plane gives each half the pixels of that constant roughness") {
+  std::string dir = test::makeTempDir();
+  // u < 1/2 (x < 0): tex1 = 0.1, u >= 1/2: tex2 = 0.5 (uscale 2: two cells across).
+  const std::string checker = R"("r": {"type": "checkerboard", "float": true, "uscale": 2, "tex1": 0.1, "tex2": 0.5})";
+  scene::SceneDescription textured = scene::parseScene(metalPlane(checker, "\"r\""), dir + "/a.json");
+  scene::SceneDescription sharp = scene::parseScene(metalPlane(checker, "0.1"), dir + "/b.json");
+  scene::SceneDescription rough = scene::parseScene(metalPlane(checker, "0.5"), dir + "/c.json");
+  REQUIRE(textured.materials[0].roughnessTexture == 0);
+  auto s = Scene::build(textured);
+  CHECK(shadedBelow(*s, -0.5f, 0.1f).alpha == 0.1f);
+  CHECK(shadedBelow(*s, 0.5f, 0.1f).alpha == 0.5f);
+  // Classification from the range [0.1, 0.5]: the sharpest, a glossy metal.
+  CHECK(s->materials[0].alpha == 0.1f);
+  CHECK(s->materials[0].isGlossy());
+  CHECK(!s->materials[0].isDeltaOnly());
+  RenderOptions o = test::smallRenderOptions(RenderMethod::PathTrace, 4, 3, 5);
+  Film t = test::renderOnce(textured, o), a = test::renderOnce(sharp, o), b = test::renderOnce(rough, o);
+  REQUIRE(t.width == 16);
+  int sameA = 0, sameB = 0, n = 0;
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 6; ++x, ++n) {  // away from the seam (the pixel filter spans it)
+      size_t l = size_t(y) * 16 + size_t(x), r = size_t(y) * 16 + size_t(15 - x);
+      sameA += t.color[l].r == a.color[l].r && t.color[l].g == a.color[l].g && t.color[l].b == a.color[l].b;
+      sameB += t.color[r].r == b.color[r].r && t.color[r].g == b.color[r].g && t.color[r].b == b.color[r].b;
+    }
+  CHECK(sameA == n);
+  CHECK(sameB == n);
+  // And the halves do differ between the two roughnesses (the test can fail).
+  CHECK(!test::sameImage(a, b));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("textured roughness from pbrt: remaproughness per hit (v4 sqrt, v3 polynomial, off), classification from the range") {
+  auto build = [](const std::string& material) {
+    std::string text = "WorldBegin\nTexture \"r\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float tex1\" 0.01 \"float tex2\" 0.25\n"
+                       "Texture \"z\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float tex1\" 0 \"float tex2\" 0.0000001\n"
+                       "Texture \"h\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float tex1\" 0 \"float tex2\" 0.25\n"
+                       "Texture \"g\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float tex1\" 0.09 \"float tex2\" 0.25\n" +
+                       material + "\nShape \"bilinearmesh\" \"point3 P\" [-1 0 -1 1 0 -1 -1 0 1 1 0 1] \"point2 uv\" [0 0 1 0 0 1 1 1]\n";
+    return Scene::build(pbrt::importPbrtText(text, "dir/t.pbrt").scene);
+  };
+  {  // pbrt-v4's conductor: alpha = sqrt(r) per hit.
+    auto s = build("Material \"conductor\" \"texture roughness\" \"r\"");
+    CHECK(pbrtBelow(*s, -0.5f, 0.1f).alpha == doctest::Approx(0.1f).epsilon(1e-6));
+    CHECK(pbrtBelow(*s, 0.5f, 0.1f).alpha == doctest::Approx(0.5f).epsilon(1e-6));
+    CHECK(s->materials[0].alpha == doctest::Approx(0.1f).epsilon(1e-6));
+    CHECK(s->materials[0].isGlossy());
+  }
+  {  // remaproughness off: the texture is alpha; the range [0.01, 0.25] is glossy at its sharp end.
+    auto s = build("Material \"conductor\" \"texture roughness\" \"r\" \"bool remaproughness\" false");
+    CHECK(pbrtBelow(*s, -0.5f, 0.1f).alpha == doctest::Approx(0.01f).epsilon(1e-6));
+    CHECK(pbrtBelow(*s, 0.5f, 0.1f).alpha == doctest::Approx(0.25f).epsilon(1e-6));
+  }
+  {  // pbrt-v3's metal: RoughnessToAlpha's polynomial in log r.
+    auto s = build("Material \"metal\" \"texture roughness\" \"r\"");
+    auto v3 = [](double r) {
+      double x = std::log(r);
+      return 1.62142 + 0.819955 * x + 0.1734 * x * x + 0.0171201 * x * x * x + 0.000640711 * x * x * x * x;
+    };
+    CHECK(pbrtBelow(*s, -0.5f, 0.1f).alpha == doctest::Approx(v3(0.01)).epsilon(1e-5));
+    CHECK(pbrtBelow(*s, 0.5f, 0.1f).alpha == doctest::Approx(v3(0.25)).epsilon(1e-5));
+    CHECK(s->materials[0].alpha == doctest::Approx(v3(0.01)).epsilon(1e-5));  // 0.139: the sharp end
+    CHECK(s->materials[0].isGlossy());
+  }
+  {  // Range [0.09, 0.25] -> alphas [0.3, 0.5]: above kGlossyAlpha everywhere, a diffuse-like gather surface.
+    auto s = build("Material \"conductor\" \"texture roughness\" \"g\"");
+    CHECK(s->materials[0].alpha == doctest::Approx(0.3f).epsilon(1e-6));
+    CHECK(!s->materials[0].isGlossy());
+    CHECK(!s->materials[0].isDeltaOnly());
+  }
+  {  // Smooth everywhere: a delta conductor, as a constant roughness 0.
+    auto s = build("Material \"conductor\" \"texture roughness\" \"z\"");
+    CHECK(s->materials[0].isDeltaOnly());
+    CHECK(s->materials[0].roughnessTexture == -1);
+  }
+  {  // Smooth on one half only: non-delta, the smooth half clamped to alpha 1e-3 (no division by zero).
+    auto s = build("Material \"conductor\" \"texture roughness\" \"h\"");
+    CHECK(!s->materials[0].isDeltaOnly());
+    CHECK(s->materials[0].isGlossy());
+    CHECK(pbrtBelow(*s, -0.5f, 0.1f).alpha == 1e-3f);
+    CHECK(pbrtBelow(*s, 0.5f, 0.1f).alpha == doctest::Approx(0.5f).epsilon(1e-6));
+  }
+  {  // A rough dielectric that is smooth on one half stays a rough dielectric (a caustic bounce).
+    auto s = build("Material \"dielectric\" \"texture roughness\" \"h\"");
+    CHECK(s->materials[0].type == Material::Type::RoughDielectric);
+    CHECK(pbrtBelow(*s, -0.5f, 0.1f).alpha == 1e-3f);
+  }
+}
+
+TEST_CASE("textured Ks (uber, substrate) and conductor reflectance: per-hit values; convert round trip renders the same pixels") {
+  std::string dir = test::makeTempDir();
+  std::string text = R"(LookAt 0 3 0  0 0 0  0 0 -1
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 12 "integer yresolution" 12
+WorldBegin
+LightSource "distant" "rgb L" [2 2 2] "point3 from" [0.3 1 0] "point3 to" [0 0 0]
+Texture "ks" "spectrum" "checkerboard" "float uscale" 2 "rgb tex1" [0.1 0.2 0.3] "rgb tex2" [0.6 0.5 0.4]
+Texture "r" "float" "checkerboard" "float vscale" 2 "float tex1" 0.04 "float tex2" 0.3
+Texture "refl" "spectrum" "checkerboard" "float uscale" 2 "rgb tex1" [0.9 0.5 0.2] "rgb tex2" [0.3 0.6 0.9]
+AttributeBegin
+Material "uber" "texture Ks" "ks" "texture roughness" "r"
+Shape "bilinearmesh" "point3 P" [-1 0 -1 1 0 -1 -1 0 1 1 0 1] "point2 uv" [0 0 1 0 0 1 1 1]
+AttributeEnd
+AttributeBegin
+Translate 3 0 0
+Material "conductor" "texture reflectance" "refl" "texture roughness" "r"
+Shape "bilinearmesh" "point3 P" [-1 0 -1 1 0 -1 -1 0 1 1 0 1] "point2 uv" [0 0 1 0 0 1 1 1]
+AttributeEnd
+AttributeBegin
+Translate -3 0 0
+Material "coatedconductor" "texture conductor.roughness" "r" "texture interface.roughness" "r"
+Shape "bilinearmesh" "point3 P" [-1 0 -1 1 0 -1 -1 0 1 1 0 1] "point2 uv" [0 0 1 0 0 1 1 1]
+AttributeEnd
+AttributeBegin
+Translate 0 0.4 0
+Material "substrate" "texture Ks" "ks" "texture vroughness" "r" "texture uroughness" "r"
+Shape "sphere" "float radius" 0.3
+AttributeEnd
+)";
+  test::writeFile(dir + "/s.pbrt", text);
+  pbrt::ImportResult r = pbrt::importPbrtFile(dir + "/s.pbrt");
+  scene::SceneDescription& d = r.scene;
+  REQUIRE(d.materials.size() == 4);
+  auto s = Scene::build(d);
+  Material uber = pbrtBelow(*s, -0.5f, -0.5f);  // u < 1/2, v > 1/2 (v runs against z)
+  checkRgb(uber.specular, Rgb(0.1f, 0.2f, 0.3f));
+  checkRgb(pbrtBelow(*s, 0.5f, -0.5f).specular, Rgb(0.6f, 0.5f, 0.4f));
+  double x = std::log(0.04);  // uber is pbrt-v3's: RoughnessToAlpha of tex1
+  CHECK(uber.alpha == doctest::Approx(1.62142 + 0.819955 * x + 0.1734 * x * x + 0.0171201 * x * x * x +
+                                      0.000640711 * x * x * x * x).epsilon(1e-5));
+  Material cond = pbrtBelow(*s, 2.5f, 0.5f);
+  checkRgb(cond.eta, Rgb(1.0f));
+  for (int i = 0; i < 3; ++i) {
+    float ri = Rgb(0.9f, 0.5f, 0.2f)[i];
+    CHECK(cond.k[i] == doctest::Approx(2 * std::sqrt(ri) / std::sqrt(1 - ri)).epsilon(1e-5));
+  }
+  // The coated conductor: both roughnesses per hit, pbrt-v4's sqrt (v = 3/4: tex2 = 0.3).
+  Material coated = pbrtBelow(*s, -3.5f, 0.5f);
+  CHECK(coated.baseAlpha == doctest::Approx(std::sqrt(0.3f)).epsilon(1e-6));
+  CHECK(coated.alpha == doctest::Approx(std::sqrt(0.3f)).epsilon(1e-6));
+  CHECK(pbrtBelow(*s, -3.5f, -0.5f).baseAlpha == doctest::Approx(0.2f).epsilon(1e-6));
+  // The round trip: the JSON names the textures and renders the same pixels.
+  std::string json = dir + "/s.json";
+  pbrt::writeSceneJson(d, json);
+  std::ifstream in(json);
+  std::string written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK(contains(written, "\"roughness\": \"r\""));
+  CHECK(contains(written, "\"roughness_remap\": \"pbrt-v4\""));
+  CHECK(contains(written, "\"roughness_remap\": \"pbrt-v3\""));
+  CHECK(contains(written, "\"specular\": \"ks\""));
+  CHECK(contains(written, "\"color\": \"refl\""));
+  CHECK(contains(written, "\"conductor_roughness\": \"r\""));
+  scene::SceneDescription back = scene::loadScene(json);
+  CHECK(nlohmann::json::parse(pbrt::sceneToJson(back, "/x/s.json").json) ==
+        nlohmann::json::parse(pbrt::sceneToJson(d, "/x/s.json").json));
+  RenderOptions o = test::smallRenderOptions(RenderMethod::PathTrace, 4, 4, 11);
+  Film a = test::renderOnce(d, o), b = test::renderOnce(back, o);
+  CHECK(test::sameImage(a, b));
+  CHECK(test::imageSum(a) > 0);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("textured material parameters: bad input gets located errors") {
+  std::string dir = test::makeTempDir();
+  std::string p = dir + "/s.json";
+  const std::string texs = R"("f": {"type": "constant", "value": 0.3, "float": true}, "c": {"type": "constant", "value": [0.3, 0.3, 0.3]})";
+  auto json = [&](const std::string& material) {
+    return errorOfJson(sceneText(R"("textures": {)" + texs + R"(}, "materials": {"m": )" + material + R"(}, "objects": [])"), p);
+  };
+  CHECK(contains(json(R"({"type": "metal", "roughness": "c"})"),
+                 "materials.m.roughness: texture \"c\" is a spectrum texture, but a float one is expected here"));
+  CHECK(contains(json(R"({"type": "uber", "specular": "f"})"),
+                 "materials.m.specular: texture \"f\" is a float texture, but a spectrum (RGB) one is expected here"));
+  CHECK(contains(json(R"({"type": "metal", "roughness": "nope"})"), "unknown texture \"nope\""));
+  CHECK(contains(json(R"({"type": "metal", "roughness": 0.3, "roughness_remap": "pbrt-v4"})"),
+                 "materials.m.roughness_remap: roughness_remap applies only to a textured roughness"));
+  CHECK(contains(json(R"({"type": "metal", "roughness": "f", "roughness_remap": "v5"})"), "materials.m.roughness_remap"));
+  CHECK(contains(json(R"({"type": "coatedconductor", "color": "c"})"),
+                 "materials.m.color: a textured reflectance is supported on conductor only"));
+  // A texture whose values reach past alpha 1: refused when the scene is built.
+  std::string big = sceneText(R"("textures": {"b": {"type": "checkerboard", "float": true, "tex1": 0.5, "tex2": 2}},
+    "materials": {"m": {"type": "metal", "roughness": "b"}}, "objects": [{"shape": {"type": "quad", "size": [1, 1]}, "material": "m"}])");
+  scene::SceneDescription d = scene::parseScene(big, p);
+  CHECK(contains(test::errorMessageOf([&] { Scene::build(d); }), "material \"m\": its roughness texture's values"));
+  // pbrt: a spectrum texture as a roughness, a textured coated conductor's base roughness.
+  auto pbrtError = [&](const std::string& body) {
+    return test::errorMessageOf([&] { pbrt::importPbrtText("WorldBegin\n" + body, dir + "/t.pbrt"); });
+  };
+  const std::string defs = "Texture \"s\" \"spectrum\" \"checkerboard\"\nTexture \"f\" \"float\" \"checkerboard\"\n";
+  CHECK(contains(pbrtError(defs + "Material \"conductor\" \"texture roughness\" \"s\"\n"),
+                 "t.pbrt:4: Material \"conductor\": parameter \"texture roughness\": texture \"s\" is a spectrum texture, but a "
+                 "roughness needs a float one"));
+  CHECK(contains(pbrtError(defs + "Material \"coatedconductor\" \"texture conductor.roughness\" \"s\"\n"),
+                 "texture \"s\" is a spectrum texture, but a roughness needs a float one"));
+  CHECK(contains(pbrtError(defs + "Material \"coatedconductor\" \"texture reflectance\" \"s\"\n"),
+                 "a textured reflectance under a coating is not supported"));
+  CHECK(contains(pbrtError(defs + "Material \"conductor\" \"texture uroughness\" \"f\" \"float vroughness\" 0.1\n"),
+                 "anisotropic roughness"));
+  CHECK(contains(pbrtError(defs + "Material \"uber\" \"texture Ks\" \"f\"\n"), "is a float texture, but a reflectance needs a spectrum one"));
+  CHECK(contains(pbrtError(defs + "Material \"conductor\" \"texture eta\" \"s\"\n"), "a texture that varies is supported only as"));
+  std::filesystem::remove_all(dir);
+}

@@ -44,7 +44,8 @@ Rgb Importer::color(const ParamSet& ps, const std::string& name, Rgb fallback) c
     if (it == textures_.end()) ps.fail(*p, "no texture named \"" + p->strings[0] + "\" has been defined");
     if (!it->second.constant)
       ps.fail(*p, "a texture that varies is supported only as a reflectance (Kd of matte and plastic, reflectance of "
-                  "diffuse, coateddiffuse and conductor, Kr of mirror, Kr = Kt of glass); here only a constant texture is");
+                  "diffuse, coateddiffuse and conductor, Kr of mirror, Kr = Kt of glass, Ks of uber and substrate); here only "
+                  "a constant texture is");
     return it->second.value;
   }
   if (p->type == "spectrum" || p->type == "blackbody") return spectrumColor(ps, *p);
@@ -58,7 +59,7 @@ double Importer::floatParam(const ParamSet& ps, const std::string& name, double 
     p->used = true;
     auto it = p->strings.size() == 1 ? textures_.find(p->strings[0]) : textures_.end();
     if (it == textures_.end() || !it->second.isFloat) ps.fail(*p, "expected a float texture");
-    if (!it->second.constant) ps.fail(*p, "a float texture that varies is not supported here (only a constant one)");
+    if (!it->second.constant) ps.fail(*p, "a float texture that varies is supported only as a roughness; here only a constant one is");
     return it->second.value.r;
   }
   if (p->type == "spectrum") return spectrumFloat(ps, *p);  // v4: a spectral eta (a constant, a named glass, ...)
@@ -218,7 +219,35 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
   scene::MaterialDesc& m = slot.desc;
   std::string label = name.empty() ? type : name;
   // pre: the parameter prefix ("interface.", "conductor." of coatedconductor).
-  auto roughnessPre = [&](const std::string& pre, bool v3, double fallback, double* alpha) {
+  // A varying float texture on pre + "roughness" (or the same one on
+  // "uroughness" and "vroughness"): its index, else -1 (a constant).
+  auto varyingRoughness = [&](const std::string& pre) -> int32_t {
+    auto tex = [&](const std::string& key) -> int32_t {
+      const Param* p = ps.find(key);
+      if (!p || p->type != "texture" || p->strings.size() != 1) return -1;
+      auto it = textures_.find(p->strings[0]);
+      if (it == textures_.end() || it->second.constant) return -1;
+      p->used = true;
+      if (!it->second.isFloat)
+        ps.fail(*p, "texture \"" + p->strings[0] + "\" is a spectrum texture, but a roughness needs a float one");
+      return it->second.index;
+    };
+    int32_t r = tex(pre + "roughness");
+    int32_t u = ps.has(pre + "uroughness") ? tex(pre + "uroughness") : r;
+    int32_t v = ps.has(pre + "vroughness") ? tex(pre + "vroughness") : r;
+    if (u != v)
+      failAt(at, label + ": anisotropic roughness (" + pre + "uroughness and " + pre + "vroughness not the same texture) is not supported");
+    return u;
+  };
+  // texture: where a textured roughness goes.
+  auto roughnessPre = [&](const std::string& pre, bool v3, double fallback, double* alpha, int32_t* texture) {
+    if (int32_t t = varyingRoughness(pre); t >= 0) {
+      *texture = t;
+      using R = scene::MaterialDesc::Remap;
+      m.roughnessRemap = !ps.getBool("remaproughness", true) ? R::None : v3 ? R::PbrtV3 : R::PbrtV4;
+      *alpha = 1.0;  // not used: the texture is, per hit (scene/build.cpp classifies from its range)
+      return;
+    }
     double u = floatParam(ps, pre + "uroughness", floatParam(ps, pre + "roughness", fallback));
     double v = floatParam(ps, pre + "vroughness", floatParam(ps, pre + "roughness", fallback));
     if (u != v)
@@ -228,12 +257,22 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     *alpha = !remap || u == 0 ? u : (v3 ? roughnessToAlphaV3(u) : std::sqrt(u));
     if (*alpha > 1) failAt(at, label + ": roughness maps to GGX alpha " + fmtNum(*alpha) + " > 1, which tdpm does not support");
   };
-  auto roughness = [&](bool v3, double fallback, double* alpha) { roughnessPre("", v3, fallback, alpha); };
+  auto roughness = [&](bool v3, double fallback, double* alpha) {
+    roughnessPre("", v3, fallback, alpha, &m.roughnessTexture);
+  };
   // A conductor's complex IOR: pre + "eta" / "k" (pbrt's default: copper),
   // or pbrt-v4's "reflectance" r, which is eta = 1, k = 2 sqrt(r) / sqrt(1 - r).
   auto conductorIor = [&](bool v3, const std::string& pre, Rgb* eta, Rgb* k) {
     if (!v3 && ps.has("reflectance")) {
-      Rgb r = color(ps, "reflectance", Rgb(1.0f));
+      int32_t tex = -1;
+      Rgb r = textureParam(ps, "reflectance", Rgb(1.0f), &tex);
+      if (tex >= 0) {
+        if (!pre.empty()) failAt(at, label + ": a textured reflectance under a coating is not supported (only a constant one)");
+        m.specularTexture = tex;  // eta = 1, k from r per hit (Scene::shadedMaterial)
+        *eta = Rgb(1.0f);
+        *k = Rgb(0.0f);
+        return;
+      }
       checkReflectance(ps, "reflectance", r);
       *eta = Rgb(1.0f);
       for (int i = 0; i < 3; ++i) {
@@ -271,7 +310,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     double alpha;
     roughness(type == "glass", 0, &alpha);
     // Rough: GGX microfacet reflection and transmission (scene/bsdf_pbrt.cpp).
-    m.type = alpha < kSmoothAlpha ? T::Dielectric : T::RoughDielectric;
+    m.type = alpha < kSmoothAlpha && m.roughnessTexture < 0 ? T::Dielectric : T::RoughDielectric;
     m.roughness = float(alpha);
     if (type == "glass") {
       int32_t tr = -1, tt = -1;
@@ -297,7 +336,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     Rgb kdDefault(type == "plastic" || type == "uber" || type == "translucent" ? 0.25f : 0.5f);
     m.albedo.color = textureParam(ps, "Kd", kdDefault, &m.albedoTexture);
     checkReflectance(ps, "Kd", m.albedo.color);
-    m.specular = color(ps, "Ks", Rgb(substrate ? 0.5f : 0.25f));
+    m.specular = textureParam(ps, "Ks", Rgb(substrate ? 0.5f : 0.25f), &m.specularTexture);
     checkReflectance(ps, "Ks", m.specular);
     double alpha;
     roughness(true, 0.1, &alpha);
@@ -324,7 +363,8 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
       (void)t;
       m.albedo.color = m.albedo.color * r;
       m.specular = m.specular * r;
-      if (m.albedoTexture >= 0) failAt(at, label + ": a textured Kd on translucent is not supported");
+      if (m.albedoTexture >= 0 || m.specularTexture >= 0)
+        failAt(at, label + ": a textured Kd or Ks on translucent is not supported");
       note(at, label + ": translucent approximated by its reflection lobes alone (Lambert reflect x Kd and GGX "
                        "reflect x Ks, as uber); its transmission is dropped (see docs/pbrt-import.md)");
     }
@@ -335,7 +375,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     if (!(eta >= 1)) failAt(at, label + ": eta below 1 is not supported");
     m.ior = float(eta);
     double alpha;
-    roughnessPre(pre, false, 0.0, &alpha);
+    roughnessPre(pre, false, 0.0, &alpha, &m.roughnessTexture);
     m.roughness = float(std::max(alpha, 1e-3));
     if (diffuse) {
       m.type = T::CoatedDiffuse;
@@ -345,7 +385,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
       m.type = T::CoatedConductor;
       conductorIor(false, "conductor.", &m.eta, &m.k);
       double base;
-      roughnessPre("conductor.", false, 0.0, &base);
+      roughnessPre("conductor.", false, 0.0, &base, &m.baseRoughnessTexture);
       m.baseRoughness = float(std::max(base, 1e-3));
     }
     m.thickness = float(floatParam(ps, "thickness", 0.01));

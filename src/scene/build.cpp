@@ -111,6 +111,12 @@ Material toMaterial(const scene::MaterialDesc& d) {
   m.albedo.invScale = 1.0f / d.albedo.scale;
   m.albedoTexture = d.albedoTexture;
   m.specularTexture = d.specularTexture;  // node i of the TextureSet is desc.textures[i]
+  m.roughnessTexture = d.roughnessTexture;
+  m.baseRoughnessTexture = d.baseRoughnessTexture;
+  using R = scene::MaterialDesc::Remap;
+  m.roughnessRemap = d.roughnessRemap == R::PbrtV3   ? RoughnessRemap::PbrtV3
+                     : d.roughnessRemap == R::PbrtV4 ? RoughnessRemap::PbrtV4
+                                                     : RoughnessRemap::None;
   m.specular = d.specular;
   m.ior = d.ior;
   // Keep GGX away from alpha -> 0, where D is a numerically unstable spike.
@@ -135,6 +141,46 @@ Material toMaterial(const scene::MaterialDesc& d) {
   m.mixOf[1] = d.mix[1];
   m.mixAmount = d.amount;
   return m;
+}
+
+// A textured roughness: the per-hit alpha comes from the texture
+// (Scene::shadedMaterial); the classification (isDeltaOnly, isGlossy) from
+// the alphas the texture's range allows, fixed per material. A conductor or
+// rough dielectric is delta (smooth) only when every value is below the
+// smooth limit; otherwise `alpha` is the sharpest alpha in range (at least
+// 1e-3), so a texture that reaches a sharp metal anywhere makes the whole
+// material a caustic bounce (docs/scene-format.md says why).
+// The alphas a roughness texture can give, [*aLo, *aHi]; an error outside [0, 1].
+void texturedAlphaRange(const Material& m, const scene::MaterialDesc& d, int32_t node, const TextureSet& textures,
+                        float* aLo, float* aHi) {
+  if (node >= int32_t(textures.nodes.size()))
+    throw Error("material \"" + d.name + "\": roughness texture index out of range");
+  float lo, hi;
+  textures.range(uint32_t(node), &lo, &hi);
+  *aLo = roughnessToAlpha(lo, m.roughnessRemap);
+  *aHi = roughnessToAlpha(hi, m.roughnessRemap);
+  if (*aLo > *aHi) std::swap(*aLo, *aHi);
+  if (!(lo >= 0) || !(*aHi <= 1))
+    throw Error("material \"" + d.name + "\": its roughness texture's values [" + std::to_string(lo) + ", " +
+                std::to_string(hi) + "] give GGX alphas [" + std::to_string(*aLo) + ", " + std::to_string(*aHi) +
+                "], outside the [0, 1] tdpm supports");
+}
+
+void classifyTexturedRoughness(Material& m, const scene::MaterialDesc& d, const TextureSet& textures) {
+  float aLo, aHi;
+  if (d.baseRoughnessTexture >= 0)  // a coated conductor's base: per hit only, no classification
+    texturedAlphaRange(m, d, d.baseRoughnessTexture, textures, &aLo, &aHi);
+  if (d.roughnessTexture < 0) return;
+  texturedAlphaRange(m, d, d.roughnessTexture, textures, &aLo, &aHi);
+  using T = Material::Type;
+  if (aHi < kSmoothAlpha && (m.type == T::Conductor || m.type == T::RoughDielectric)) {
+    m.roughnessTexture = -1;  // smooth everywhere: as a constant roughness 0
+    m.alpha = 0.0f;
+    if (m.type == T::RoughDielectric) m.type = T::Dielectric;
+    return;
+  }
+  if (m.type == T::Dielectric) m.type = T::RoughDielectric;  // JSON: "dielectric" with a roughness texture
+  m.alpha = std::max(aLo, kSmoothAlpha);
 }
 
 // A mix's components' classification (Material::causticTarget), through
@@ -334,12 +380,14 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
   s.shutter = s.camera.shutter();
   s.background = desc.background;
   s.hasMotion = s.camera.moving();
-  for (const auto& m : desc.materials) s.materials.push_back(toMaterial(m));
+  s.textures = toTextures(desc.textures);
+  for (const auto& m : desc.materials) {
+    s.materials.push_back(toMaterial(m));
+    if (m.roughnessTexture >= 0 || m.baseRoughnessTexture >= 0) classifyTexturedRoughness(s.materials.back(), m, s.textures);
+  }
   std::vector<uint8_t> mixState(s.materials.size(), 0);
   for (size_t i = 0; i < s.materials.size(); ++i)
     if (s.materials[i].type == Material::Type::Mix) classifyMix(s.materials, desc.materials, i, mixState);
-
-  s.textures = toTextures(desc.textures);
 
   for (const auto& od : desc.objects) {
     SceneObject o;

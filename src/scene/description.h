@@ -103,8 +103,16 @@ struct MaterialDesc {
   // textures, a spectrum one) that replaces albedo when >= 0.
   int32_t albedoTexture = -1;
   // Mirror, metal, dielectric (and pbrt's glass): a spectrum texture for
-  // `specular` when >= 0.
+  // `specular` when >= 0; conductor: its reflectance (the "color" form);
+  // uber, substrate: Ks.
   int32_t specularTexture = -1;
+  // Every material with a roughness: a float texture (index into
+  // SceneDescription::textures) for `roughness` when >= 0, remapped per hit
+  // (pbrt's remaproughness: none, pbrt-v3's polynomial, pbrt-v4's sqrt).
+  int32_t roughnessTexture = -1;
+  int32_t baseRoughnessTexture = -1;  // coated conductor: a float texture for baseRoughness, same remap
+  enum class Remap { None, PbrtV3, PbrtV4 };
+  Remap roughnessRemap = Remap::None;
 };
 
 struct ShapeDesc {

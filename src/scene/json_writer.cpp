@@ -158,51 +158,61 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
     else j["texture"] = texture(m.albedo);
   };
   Json spec = m.specularTexture >= 0 ? Json(textures.at(size_t(m.specularTexture))) : rgb(m.specular);
+  // A textured roughness: the texture's name and its remap (parse.cpp).
+  using R = scene::MaterialDesc::Remap;
+  if ((m.roughnessTexture >= 0 || m.baseRoughnessTexture >= 0) && m.roughnessRemap != R::None)
+    j["roughness_remap"] = m.roughnessRemap == R::PbrtV3 ? "pbrt-v3" : "pbrt-v4";
+  auto rough = [&]() -> Json { return m.roughnessTexture < 0 ? Json(num(m.roughness)) : Json(textures.at(size_t(m.roughnessTexture))); };
   switch (m.type) {
     case T::Diffuse: j["type"] = "diffuse"; albedo(); break;
     case T::Mirror: j["type"] = "mirror"; j["color"] = spec; break;
     case T::Dielectric: j["type"] = "dielectric"; j["ior"] = num(m.ior); j["tint"] = spec; break;
-    case T::Metal: j["type"] = "metal"; j["color"] = spec; j["roughness"] = num(m.roughness); break;
+    case T::Metal: j["type"] = "metal"; j["color"] = spec; j["roughness"] = rough(); break;
     case T::Plastic:
       j["type"] = "plastic";
       albedo();
       j["ior"] = num(m.ior);
-      j["roughness"] = num(m.roughness);
+      j["roughness"] = rough();
       break;
     case T::Conductor:
       j["type"] = "conductor";
-      j["eta"] = rgb(m.eta);
-      j["k"] = rgb(m.k);
-      j["roughness"] = num(m.roughness);
+      if (m.specularTexture >= 0) {
+        j["color"] = spec;  // a textured reflectance (eta, k per hit)
+      } else {
+        j["eta"] = rgb(m.eta);
+        j["k"] = rgb(m.k);
+      }
+      j["roughness"] = rough();
       break;
     case T::RoughDielectric:
       j["type"] = "dielectric";
       j["ior"] = num(m.ior);
       j["tint"] = spec;
-      j["roughness"] = num(m.roughness);
+      j["roughness"] = rough();
       break;
     case T::Uber:
     case T::Substrate:
       j["type"] = m.type == T::Uber ? "uber" : "substrate";
       albedo();
-      j["specular"] = rgb(m.specular);
+      j["specular"] = spec;
       if (m.type == T::Uber) j["ior"] = num(m.ior);
-      j["roughness"] = num(m.roughness);
+      j["roughness"] = rough();
       break;
     case T::CoatedDiffuse:
       j["type"] = "coateddiffuse";
       albedo();
       j["ior"] = num(m.ior);
-      j["roughness"] = num(m.roughness);
+      j["roughness"] = rough();
       j["thickness"] = num(m.thickness);
       break;
     case T::CoatedConductor:
       j["type"] = "coatedconductor";
       j["ior"] = num(m.ior);
-      j["roughness"] = num(m.roughness);
+      j["roughness"] = rough();
       j["eta"] = rgb(m.eta);
       j["k"] = rgb(m.k);
-      j["conductor_roughness"] = num(m.baseRoughness);
+      j["conductor_roughness"] =
+          m.baseRoughnessTexture < 0 ? Json(num(m.baseRoughness)) : Json(textures.at(size_t(m.baseRoughnessTexture)));
       j["thickness"] = num(m.thickness);
       break;
     case T::Mix:

@@ -2,6 +2,7 @@
 // classification (delta-specular vs. diffuse-like) that photon mapping needs:
 // photons are stored only on surfaces with a non-delta component.
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -27,6 +28,17 @@ struct Texture {
     return ((ix + iy + iz) & 1) ? b : a;
   }
 };
+
+// pbrt's remaproughness, applied per hit to a textured roughness (the
+// importer applies it to a constant one): pbrt-v3's polynomial in log r
+// (RoughnessToAlpha of its microfacet.cpp) or pbrt-v4's sqrt(r); r = 0 stays 0.
+enum class RoughnessRemap : uint8_t { None, PbrtV3, PbrtV4 };
+inline float roughnessToAlpha(float r, RoughnessRemap remap) {
+  if (remap == RoughnessRemap::None || r <= 0.0f) return r;
+  if (remap == RoughnessRemap::PbrtV4) return std::sqrt(r);
+  float x = std::log(std::max(r, 1e-3f));
+  return 1.62142f + 0.819955f * x + 0.1734f * x * x + 0.0171201f * x * x * x + 0.000640711f * x * x * x * x;
+}
 
 struct Material {
   // Conductor .. Mix are pbrt's materials (issue 23; scene/bsdf_pbrt.cpp,
@@ -59,7 +71,17 @@ struct Material {
   // >= 0: `specular` (mirror / metal reflectance, dielectric tint) is this
   // node at the hit (Scene::shadedMaterial). Classification (isGlossy, ...)
   // does not depend on it.
+  // A conductor's: its pbrt-v4 reflectance (per hit eta = 1, k = 2 sqrt(r) / sqrt(1 - r));
+  // uber's, substrate's: Ks.
   int32_t specularTexture = -1;
+  // >= 0: the GGX alpha is this float node at the hit, through
+  // roughnessRemap, clamped to [1e-3, 1]. `alpha` above then holds the
+  // classification alpha: the sharpest the texture's range allows
+  // (scene/build.cpp, docs/scene-format.md), so isGlossy / isDeltaOnly stay
+  // fixed per material.
+  int32_t roughnessTexture = -1;
+  int32_t baseRoughnessTexture = -1;  // coated conductor: baseAlpha per hit, as roughnessTexture
+  RoughnessRemap roughnessRemap = RoughnessRemap::None;
 
   // Purely delta (mirror, glass, smooth conductor): no photon is stored
   // here, no light sampling.

@@ -587,9 +587,30 @@ float readRoughnessOrZero(const Node& n) {
 // A conductor's complex IOR: "eta" and "k", or a normal-incidence
 // reflectance "color", which becomes eta = 1, k = 2 sqrt(r) / sqrt(1 - r)
 // (pbrt-v4's conductor "reflectance": the Fresnel curve through r).
-void readConductor(const Node& n, MaterialDesc* m) {
+// A material parameter naming a texture: its index, a located error when
+// it is unknown or of the other kind (float / spectrum).
+int32_t namedTextureIndex(const Node& c, TextureReader* textures, bool isFloat) {
+  if (!textures) c.fail("unknown texture \"" + c.string() + "\"; no textures are defined");
+  int32_t i = textures->index(c.string(), c);
+  if ((*textures->out())[size_t(i)].isFloat != isFloat)
+    c.fail("texture \"" + c.string() + "\" is a " + (isFloat ? "spectrum" : "float") + " texture, but a " +
+           (isFloat ? "float" : "spectrum (RGB)") + " one is expected here");
+  return i;
+}
+int32_t spectrumTextureIndex(const Node& c, TextureReader* textures) { return namedTextureIndex(c, textures, false); }
+
+// conductor: "color" may name a spectrum texture (a reflectance per hit).
+void readConductor(const Node& n, MaterialDesc* m, TextureReader* textures) {
   if (n.has("color") && (n.has("eta") || n.has("k")))
     n.member("color").fail("give either \"color\" (a reflectance) or \"eta\" and \"k\", not both");
+  if (n.has("color") && n.member("color").json().is_string()) {
+    n.member("color").require(m->type == MaterialDesc::Type::Conductor,
+                              "a textured reflectance is supported on conductor only, not under a coating");
+    m->eta = Rgb(1.0f);  // per hit from the texture (Scene::shadedMaterial)
+    m->k = Rgb(0.0f);
+    m->specularTexture = spectrumTextureIndex(n.member("color"), textures);
+    return;
+  }
   if (n.has("color")) {
     Rgb r = readReflectance(n.member("color"));
     m->eta = Rgb(1.0f);
@@ -615,15 +636,15 @@ const std::vector<MaterialKind>& materialKinds() {
   static const std::vector<MaterialKind> kinds = {
       {"diffuse", T::Diffuse, {"type", "color", "texture"}},
       {"mirror", T::Mirror, {"type", "color"}},
-      {"dielectric", T::Dielectric, {"type", "ior", "tint", "roughness"}},
-      {"metal", T::Metal, {"type", "color", "roughness"}},
-      {"plastic", T::Plastic, {"type", "color", "texture", "ior", "roughness"}},
-      {"conductor", T::Conductor, {"type", "eta", "k", "color", "roughness"}},
-      {"uber", T::Uber, {"type", "color", "texture", "specular", "ior", "roughness"}},
-      {"substrate", T::Substrate, {"type", "color", "texture", "specular", "roughness"}},
-      {"coateddiffuse", T::CoatedDiffuse, {"type", "color", "texture", "ior", "roughness", "thickness"}},
+      {"dielectric", T::Dielectric, {"type", "ior", "tint", "roughness", "roughness_remap"}},
+      {"metal", T::Metal, {"type", "color", "roughness", "roughness_remap"}},
+      {"plastic", T::Plastic, {"type", "color", "texture", "ior", "roughness", "roughness_remap"}},
+      {"conductor", T::Conductor, {"type", "eta", "k", "color", "roughness", "roughness_remap"}},
+      {"uber", T::Uber, {"type", "color", "texture", "specular", "ior", "roughness", "roughness_remap"}},
+      {"substrate", T::Substrate, {"type", "color", "texture", "specular", "roughness", "roughness_remap"}},
+      {"coateddiffuse", T::CoatedDiffuse, {"type", "color", "texture", "ior", "roughness", "roughness_remap", "thickness"}},
       {"coatedconductor", T::CoatedConductor,
-       {"type", "ior", "roughness", "eta", "k", "color", "conductor_roughness", "thickness"}},
+       {"type", "ior", "roughness", "roughness_remap", "eta", "k", "color", "conductor_roughness", "thickness"}},
       {"mix", T::Mix, {"type", "materials", "amount"}},
   };
   return kinds;
@@ -664,13 +685,10 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader*
       m.specular = readReflectance(c);
       return;
     }
-    if (!textures) c.fail("unknown texture \"" + c.string() + "\"; no textures are defined");
-    m.specularTexture = textures->index(c.string(), c);
-    if ((*textures->out())[size_t(m.specularTexture)].isFloat)
-      c.fail("texture \"" + c.string() + "\" is a float texture, but a spectrum (RGB) one is expected here");
+    m.specularTexture = spectrumTextureIndex(c, textures);
   };
   if (kind.type == T::Conductor || kind.type == T::CoatedConductor) {
-    readConductor(n, &m);
+    readConductor(n, &m, textures);
   } else {
     bool albedo = kind.type == T::Diffuse || kind.type == T::Plastic || kind.type == T::Uber ||
                   kind.type == T::Substrate || kind.type == T::CoatedDiffuse;
@@ -678,7 +696,7 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader*
     else if (n.has("color")) specular(n.member("color"));
   }
   if (n.has("tint")) specular(n.member("tint"));
-  if (n.has("specular")) m.specular = readReflectance(n.member("specular"));
+  if (n.has("specular")) specular(n.member("specular"));
   else if (kind.type == T::Uber || kind.type == T::Substrate) m.specular = Rgb(0.25f);  // pbrt-v3's Ks
   if (n.has("ior")) m.ior = readIor(n.member("ior"));
   if (kind.type == T::Dielectric && n.has("roughness")) {
@@ -686,8 +704,23 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader*
     pbrtKind = true;
   }
   if (pbrtKind) m.roughness = 0.0f;
-  if (n.has("roughness")) m.roughness = pbrtKind ? readRoughnessOrZero(n.member("roughness")) : readRoughness(n.member("roughness"));
-  if (n.has("conductor_roughness")) m.baseRoughness = readRoughnessOrZero(n.member("conductor_roughness"));
+  if (n.has("roughness") && n.member("roughness").json().is_string()) {
+    // A float texture, evaluated per hit (GGX alpha, or through roughness_remap).
+    m.roughnessTexture = namedTextureIndex(n.member("roughness"), textures, true);
+  } else if (n.has("roughness")) {
+    m.roughness = pbrtKind ? readRoughnessOrZero(n.member("roughness")) : readRoughness(n.member("roughness"));
+  }
+  if (n.has("conductor_roughness") && n.member("conductor_roughness").json().is_string())
+    m.baseRoughnessTexture = namedTextureIndex(n.member("conductor_roughness"), textures, true);
+  else if (n.has("conductor_roughness"))
+    m.baseRoughness = readRoughnessOrZero(n.member("conductor_roughness"));
+  if (n.has("roughness_remap")) {
+    Node r = n.member("roughness_remap");
+    std::string v = r.choice({"none", "pbrt-v3", "pbrt-v4"}, "roughness_remap");
+    r.require(m.roughnessTexture >= 0 || m.baseRoughnessTexture >= 0,
+              "roughness_remap applies only to a textured roughness (a constant one is the GGX alpha)");
+    m.roughnessRemap = v == "pbrt-v3" ? MaterialDesc::Remap::PbrtV3 : v == "pbrt-v4" ? MaterialDesc::Remap::PbrtV4 : MaterialDesc::Remap::None;
+  }
   if (n.has("thickness")) {
     m.thickness = n.member("thickness").number();
     n.member("thickness").require(m.thickness >= 0 && std::isfinite(m.thickness), "thickness must be non-negative, got " + fmt(m.thickness));

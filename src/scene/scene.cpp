@@ -122,3 +122,35 @@ bool Scene::occluded(Vec3f o, Vec3f d, float tFar, float time01) const {
 }
 
 }  // namespace tdpm
+
+namespace tdpm {
+
+const Material& Scene::shadeTextured(const Material& m, const Hit& hit, std::optional<Material>& scratch) const {
+  TexturePoint tp{uvAt(hit), hit.localP};
+  scratch.emplace(m);
+  if (m.specularTexture >= 0) {
+    Rgb v = textures.eval(uint32_t(m.specularTexture), tp);
+    Rgb r{std::clamp(v.r, 0.0f, 1.0f), std::clamp(v.g, 0.0f, 1.0f), std::clamp(v.b, 0.0f, 1.0f)};
+    if (m.type == Material::Type::Conductor) {
+      // pbrt-v4's conductor reflectance, as the constant path (parse.cpp, pbrt_mapping.cpp).
+      scratch->eta = Rgb(1.0f);
+      for (int i = 0; i < 3; ++i) {
+        float ri = std::min(r[i], 0.9999f);
+        scratch->k[i] = 2.0f * std::sqrt(ri) / std::sqrt(1.0f - ri);
+      }
+    } else {
+      scratch->specular = r;
+    }
+  }
+  if (m.roughnessTexture >= 0) {
+    float x = textures.eval(uint32_t(m.roughnessTexture), tp).r;
+    scratch->alpha = std::clamp(roughnessToAlpha(x, m.roughnessRemap), 1e-3f, 1.0f);
+  }
+  if (m.baseRoughnessTexture >= 0) {
+    float x = textures.eval(uint32_t(m.baseRoughnessTexture), tp).r;
+    scratch->baseAlpha = std::clamp(roughnessToAlpha(x, m.roughnessRemap), 1e-3f, 1.0f);
+  }
+  return *scratch;
+}
+
+}  // namespace tdpm

@@ -69,15 +69,15 @@ class Scene {
     Rgb v = textures.eval(uint32_t(m.albedoTexture), {uvAt(hit), hit.localP});
     return {std::clamp(v.r, 0.0f, 1.0f), std::clamp(v.g, 0.0f, 1.0f), std::clamp(v.b, 0.0f, 1.0f)};
   }
-  // The material the BSDF sees at the hit: m itself, or (a textured
-  // specular colour) a copy in `scratch` with the value at the hit, clamped
-  // to [0, 1]. An empty optional costs an untextured hit nothing.
+  // The material the BSDF sees at the hit: m itself, or (textured
+  // parameters) a copy in `scratch` with the values at the hit: the
+  // specular colour clamped to [0, 1] (a conductor's reflectance becomes
+  // its eta, k), the roughness remapped and clamped to [1e-3, 1] (never a
+  // delta lobe on a material classified non-delta). An empty optional costs
+  // an untextured hit nothing.
   const Material& shadedMaterial(const Material& m, const Hit& hit, std::optional<Material>& scratch) const {
-    if (m.specularTexture < 0) return m;
-    Rgb v = textures.eval(uint32_t(m.specularTexture), {uvAt(hit), hit.localP});
-    scratch.emplace(m);
-    scratch->specular = {std::clamp(v.r, 0.0f, 1.0f), std::clamp(v.g, 0.0f, 1.0f), std::clamp(v.b, 0.0f, 1.0f)};
-    return *scratch;
+    if (m.specularTexture < 0 && m.roughnessTexture < 0 && m.baseRoughnessTexture < 0) return m;
+    return shadeTextured(m, hit, scratch);
   }
   // The raw ray tracer (benchmarks compare our tracing against it).
   const EmbreeScene& embree() const { return embree_; }
@@ -114,6 +114,7 @@ class Scene {
   bool hasMotion = false;             // any moving object, light or camera
 
  private:
+  const Material& shadeTextured(const Material& m, const Hit& hit, std::optional<Material>& scratch) const;
   EmbreeScene embree_;
   // Embree geometry id -> object index (>= 0) or -(light index) - 1.
   std::vector<int32_t> geometryOwner_;

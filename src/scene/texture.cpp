@@ -74,4 +74,67 @@ Rgb TextureSet::eval(uint32_t index, const TexturePoint& p) const {
   return Rgb(0.0f);
 }
 
+void TextureSet::range(uint32_t index, float* lo, float* hi) const {
+  const TextureNode& n = nodes[index];
+  float al, ah, bl, bh;
+  switch (n.kind) {
+    case TextureNode::Kind::Constant: *lo = *hi = n.a.value.r; return;
+    case TextureNode::Kind::Image: {
+      const TextureImage& im = images[n.image];
+      // Black wrap and lookups beyond float precision give 0.
+      float l = 0, h = 0;
+      bool first = n.wrap != TextureNode::Wrap::Black;
+      for (size_t i = 0; i < size_t(im.width) * size_t(im.height); ++i) {
+        float v = texels[im.offset + i].r;
+        l = first ? v : std::min(l, v);
+        h = first ? v : std::max(h, v);
+        first = false;
+      }
+      l = std::min(l * n.scale, h * n.scale);  // scale >= 0 (checked on input), but keep the order
+      h = std::max(l, h * n.scale);
+      if (n.invert) {
+        float il = std::max(0.0f, 1 - h), ih = std::max(0.0f, 1 - l);
+        l = il;
+        h = ih;
+      }
+      *lo = l;
+      *hi = h;
+      return;
+    }
+    case TextureNode::Kind::Scale: {
+      inputRange(n.a, &al, &ah);
+      inputRange(n.b, &bl, &bh);
+      float c[4] = {al * bl, al * bh, ah * bl, ah * bh};
+      *lo = std::min(std::min(c[0], c[1]), std::min(c[2], c[3]));
+      *hi = std::max(std::max(c[0], c[1]), std::max(c[2], c[3]));
+      return;
+    }
+    case TextureNode::Kind::Mix: {
+      // (1 - t) a + t b is linear in each of a, b, t: extremes at the box's corners.
+      float tl, th;
+      inputRange(n.a, &al, &ah);
+      inputRange(n.b, &bl, &bh);
+      inputRange(n.amount, &tl, &th);
+      *lo = INFINITY;
+      *hi = -INFINITY;
+      for (float a : {al, ah})
+        for (float b : {bl, bh})
+          for (float t : {tl, th}) {
+            float v = a * (1 - t) + b * t;
+            *lo = std::min(*lo, v);
+            *hi = std::max(*hi, v);
+          }
+      return;
+    }
+    case TextureNode::Kind::Checkerboard:
+    case TextureNode::Kind::Checker3D:
+      inputRange(n.a, &al, &ah);
+      inputRange(n.b, &bl, &bh);
+      *lo = std::min(al, bl);
+      *hi = std::max(ah, bh);
+      return;
+  }
+  *lo = *hi = 0;
+}
+
 }  // namespace tdpm

@@ -50,6 +50,12 @@ class TextureSet {
   std::vector<Rgb> texels;
 
   Rgb eval(uint32_t node, const TexturePoint& p) const;
+  // Bounds on the first channel of eval(node, p) over every p: from the
+  // constants and each image's texels (bilinear lookups are convex
+  // combinations of them), through the node tree; conservative, not tight
+  // (a mix's bound takes its inputs' independently). Classifies a material
+  // with a textured roughness (scene/build.cpp).
+  void range(uint32_t node, float* lo, float* hi) const;
   // One texel with the wrap mode applied (Black outside: 0).
   Rgb texel(const TextureImage& im, TextureNode::Wrap wrap, int x, int y) const;
   // pbrt's lookup of image st (st in [0,1]^2, t = 0 at the bottom row):
@@ -57,6 +63,10 @@ class TextureSet {
   Rgb lookup(const TextureImage& im, TextureNode::Wrap wrap, bool bilinear, float s, float t) const;
 
  private:
+  void inputRange(const TexNodeInput& in, float* lo, float* hi) const {
+    if (in.node < 0) *lo = *hi = in.value.r;
+    else range(uint32_t(in.node), lo, hi);
+  }
   Rgb input(const TexNodeInput& in, const TexturePoint& p) const {
     return in.node < 0 ? in.value : eval(uint32_t(in.node), p);
   }
