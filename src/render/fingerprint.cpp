@@ -105,6 +105,20 @@ std::map<std::string, std::string> renderSettings(const RenderOptions& o, int wi
   return s;
 }
 
+// A mesh by its bytes under `label`, then emptied so the JSON text hashed
+// after it does not carry the triangles (or the file they came from) again.
+static void hashMeshBytes(Hasher& h, const std::string& label, scene::ShapeDesc& s) {
+  h.add(label);
+  uint64_t nv = s.vertices.size(), ni = s.indices.size();
+  h.add(&nv, sizeof nv);
+  h.add(s.vertices.data(), s.vertices.size() * sizeof(Vec3f));
+  h.add(&ni, sizeof ni);
+  h.add(s.indices.data(), s.indices.size() * sizeof(uint32_t));
+  s.vertices.clear();
+  s.indices.clear();
+  s.meshFile.clear();
+}
+
 std::string sceneDigest(const scene::SceneDescription& d) {
   Hasher h;
   scene::SceneDescription c = d;
@@ -119,29 +133,12 @@ std::string sceneDigest(const scene::SceneDescription& d) {
     if (s.type != scene::ShapeDesc::Type::Mesh) continue;
     // The triangles by their bytes (exact, and cheaper than OBJ text); the
     // file they came from does not matter.
-    h.add("mesh " + o.name);
-    uint64_t nv = s.vertices.size(), ni = s.indices.size();
-    h.add(&nv, sizeof nv);
-    h.add(s.vertices.data(), s.vertices.size() * sizeof(Vec3f));
-    h.add(&ni, sizeof ni);
-    h.add(s.indices.data(), s.indices.size() * sizeof(uint32_t));
-    s.vertices.clear();
-    s.indices.clear();
-    s.meshFile.clear();
+    hashMeshBytes(h, "mesh " + o.name, s);
   }
   for (scene::LightDesc& l : c.lights) {
     if (l.areaShape == scene::LightDesc::AreaShape::Mesh) {
       // A mesh light's triangles, as a mesh object's.
-      scene::ShapeDesc& s = l.mesh;
-      h.add("mesh light " + l.name);
-      uint64_t nv = s.vertices.size(), ni = s.indices.size();
-      h.add(&nv, sizeof nv);
-      h.add(s.vertices.data(), s.vertices.size() * sizeof(Vec3f));
-      h.add(&ni, sizeof ni);
-      h.add(s.indices.data(), s.indices.size() * sizeof(uint32_t));
-      s.vertices.clear();
-      s.indices.clear();
-      s.meshFile.clear();
+      hashMeshBytes(h, "mesh light " + l.name, l.mesh);
     }
     if (!l.map) continue;
     // An environment map by its (lat-long) texels, like a mesh by its triangles.

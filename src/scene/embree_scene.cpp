@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -234,24 +235,41 @@ uint32_t EmbreeScene::addMovingTriangles(const std::vector<Vec3f>& objectVertice
   return impl_->record(Impl::kMovingMeshes, e, swept);
 }
 
-uint32_t EmbreeScene::addSphere(const std::vector<Vec3f>& centres, const std::vector<float>& radii) {
-  TDPM_ASSERT(!centres.empty() && centres.size() == radii.size(), "bad sphere input");
-  RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+// Spheres and discs are both Embree points in the sphere layer: a centre and
+// radius per time step, and for a disc its unit normal.
+static uint32_t addPointGeometry(RTCDevice device, RTCScene layer, RTCGeometryType type, const std::vector<Vec3f>& centres,
+                                 const std::vector<Vec3f>* normals, const std::vector<float>& radii,
+                                 const std::function<void(const char*)>& check, Bounds3f& swept) {
+  RTCGeometry g = rtcNewGeometry(device, type);
   rtcSetGeometryTimeStepCount(g, unsigned(centres.size()));
-  Bounds3f swept;
   for (size_t s = 0; s < centres.size(); ++s) {
     auto* v = static_cast<float*>(
         rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, unsigned(s), RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
-    if (!v) { rtcReleaseGeometry(g); impl_->check("allocate a sphere buffer"); }
+    float* n = normals ? static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_NORMAL, unsigned(s),
+                                                                     RTC_FORMAT_FLOAT3, 3 * sizeof(float), 1))
+                       : nullptr;
+    if (!v || (normals && !n)) {
+      rtcReleaseGeometry(g);
+      check(normals ? "allocate a disc buffer" : "allocate a sphere buffer");
+    }
     v[0] = centres[s].x; v[1] = centres[s].y; v[2] = centres[s].z; v[3] = radii[s];
+    if (n) { n[0] = (*normals)[s].x; n[1] = (*normals)[s].y; n[2] = (*normals)[s].z; }
     Vec3f r(std::fabs(radii[s]));
     swept.extend(centres[s] - r);
     swept.extend(centres[s] + r);
   }
   rtcCommitGeometry(g);
-  uint32_t e = rtcAttachGeometry(impl_->layers[Impl::kSpheres].scene, g);
+  uint32_t e = rtcAttachGeometry(layer, g);
   rtcReleaseGeometry(g);
-  impl_->check("add a sphere");
+  check(normals ? "add a disc" : "add a sphere");
+  return e;
+}
+
+uint32_t EmbreeScene::addSphere(const std::vector<Vec3f>& centres, const std::vector<float>& radii) {
+  TDPM_ASSERT(!centres.empty() && centres.size() == radii.size(), "bad sphere input");
+  Bounds3f swept;
+  uint32_t e = addPointGeometry(impl_->device, impl_->layers[Impl::kSpheres].scene, RTC_GEOMETRY_TYPE_SPHERE_POINT, centres,
+                                nullptr, radii, [&](const char* what) { impl_->check(what); }, swept);
   return impl_->record(Impl::kSpheres, e, swept);
 }
 
@@ -280,25 +298,9 @@ uint32_t EmbreeScene::addQuadric(const Quadric& shape, const Motion& motion) {
 uint32_t EmbreeScene::addOrientedDisc(const std::vector<Vec3f>& centres, const std::vector<Vec3f>& normals,
                                       const std::vector<float>& radii) {
   TDPM_ASSERT(!centres.empty() && centres.size() == radii.size() && centres.size() == normals.size(), "bad disc input");
-  RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
-  rtcSetGeometryTimeStepCount(g, unsigned(centres.size()));
   Bounds3f swept;
-  for (size_t s = 0; s < centres.size(); ++s) {
-    auto* v = static_cast<float*>(
-        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, unsigned(s), RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
-    auto* n = static_cast<float*>(
-        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_NORMAL, unsigned(s), RTC_FORMAT_FLOAT3, 3 * sizeof(float), 1));
-    if (!v || !n) { rtcReleaseGeometry(g); impl_->check("allocate a disc buffer"); }
-    v[0] = centres[s].x; v[1] = centres[s].y; v[2] = centres[s].z; v[3] = radii[s];
-    n[0] = normals[s].x; n[1] = normals[s].y; n[2] = normals[s].z;
-    Vec3f r(std::fabs(radii[s]));
-    swept.extend(centres[s] - r);
-    swept.extend(centres[s] + r);
-  }
-  rtcCommitGeometry(g);
-  uint32_t e = rtcAttachGeometry(impl_->layers[Impl::kSpheres].scene, g);
-  rtcReleaseGeometry(g);
-  impl_->check("add a disc");
+  uint32_t e = addPointGeometry(impl_->device, impl_->layers[Impl::kSpheres].scene, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT,
+                                centres, &normals, radii, [&](const char* what) { impl_->check(what); }, swept);
   return impl_->record(Impl::kSpheres, e, swept);
 }
 
