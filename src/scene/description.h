@@ -13,6 +13,7 @@
 
 #include "image/image.h"
 #include "image/texture_image.h"
+#include "math/bounds.h"
 #include "math/transform.h"
 #include "math/vec.h"
 
@@ -84,6 +85,47 @@ struct TextureDef {
   float cell = 1;  // checker3d: cell size (m), cells centred as the inline "checker"
 };
 
+// ---- participating media (docs/scene-format.md "media"; issue 25) ----
+// A named medium. Coefficients are per scene unit (1/m): sigma = scale x
+// sigma_{a,s} (homogeneous) or scale x sigma_{a,s} x density(x) (grid).
+// JSON: "media": {"fog": {"type": "homogeneous", "sigma_a": [r,g,b],
+// "sigma_s": [r,g,b], "scale": 1, "g": 0}, "smoke": {"type": "grid", ...,
+// "resolution": [nx, ny, nz], "density": [nx*ny*nz numbers, x fastest],
+// (or "file": "smoke.vdb", "grid": "density"), "bounds": [[x0,y0,z0],
+// [x1,y1,z1]], "transform": {...}}}.
+struct DensityGridDesc {
+  // Density at cell centres, x fastest then y then z, every value >= 0 and
+  // finite; interpolated trilinearly (pbrt's uniformgrid / nanovdb media),
+  // zero outside `bounds`.
+  int nx = 0, ny = 0, nz = 0;
+  std::vector<float> density;
+  Bounds3f bounds{{0, 0, 0}, {1, 1, 1}};  // medium space: the box the cells tile
+  std::string file;          // as resolved against the scene's directory; empty: inline
+  std::string gridName = "density";  // the grid read from `file` (OpenVDB / NanoVDB)
+};
+
+struct MediumDesc {
+  enum class Type { Homogeneous, Grid };
+  Type type = Type::Homogeneous;
+  std::string name;
+  Rgb sigmaA{0, 0, 0}, sigmaS{0, 0, 0};  // >= 0 each, per scene unit
+  float scale = 1.0f;                    // >= 0
+  float g = 0.0f;                        // Henyey-Greenstein asymmetry, in (-1, 1)
+  DensityGridDesc grid;                  // Type::Grid
+  // Grid: medium-to-world (or medium-to-object for a medium inside an
+  // object, which then moves with the object); homogeneous media ignore it.
+  TransformDesc placement;
+};
+
+// Which media meet at a surface (pbrt's MediumInterface): the medium on the
+// side the normal points into (outside) and on the other (inside). Index
+// into SceneDescription::media, or -1 for vacuum. An object without one
+// (present == false) is no medium boundary: a ray keeps its medium across it.
+struct MediumInterfaceDesc {
+  bool present = false;
+  int32_t inside = -1, outside = -1;
+};
+
 struct MaterialDesc {
   // Conductor .. Mix: pbrt's materials (scene/material.h, docs/scene-format.md).
   enum class Type { Diffuse, Mirror, Dielectric, Metal, Plastic,
@@ -151,6 +193,10 @@ struct ObjectDesc {
   uint32_t material = 0;  // index into SceneDescription::materials
   TransformDesc placement;
   MotionDesc motion;
+  // Media on its two sides. JSON "medium": "fog" (a closed shape's interior;
+  // outside = the scene's exterior medium) or "medium_interface": {"inside":
+  // name | null, "outside": name | null} (any shape, as pbrt).
+  MediumInterfaceDesc media;
 };
 
 struct LightDesc {
@@ -185,6 +231,9 @@ struct LightDesc {
   // The map's texels as lat-long (converted when equalArea), read and
   // checked by the parser (or the pbrt importer).
   std::shared_ptr<const image::ImageRgb> map;
+  // The medium the light emits into (photons start in it): index into
+  // SceneDescription::media, -1 vacuum; JSON "medium", default the exterior.
+  int32_t medium = -1;
 };
 
 struct CameraKeyframe {
@@ -206,6 +255,9 @@ struct CameraDesc {
   // distance along the view direction of the plane in focus (> 0).
   float lensRadius = 0.0f;
   float focalDistance = 1.0f;
+  // The medium the camera sits in: index into SceneDescription::media, -1
+  // vacuum; JSON camera "medium", default the exterior medium.
+  int32_t medium = -1;
 };
 
 // Render settings stored in the scene. Each is optional: command-line flags
@@ -268,6 +320,10 @@ struct SceneDescription {
   std::vector<MaterialDesc> materials;
   std::vector<ObjectDesc> objects;
   std::vector<LightDesc> lights;
+  std::vector<MediumDesc> media;
+  // The medium everywhere outside every object's interior (JSON
+  // "exterior_medium": a name): index into media, -1 vacuum.
+  int32_t exteriorMedium = -1;
   Rgb background{0, 0, 0};  // radiance of rays that escape
   RenderSettings render;
 };
