@@ -104,6 +104,7 @@ Material toMaterial(const scene::MaterialDesc& d) {
     case scene::MaterialDesc::Type::CoatedDiffuse: m.type = Material::Type::CoatedDiffuse; break;
     case scene::MaterialDesc::Type::CoatedConductor: m.type = Material::Type::CoatedConductor; break;
     case scene::MaterialDesc::Type::Mix: m.type = Material::Type::Mix; break;
+    case scene::MaterialDesc::Type::Interface: m.type = Material::Type::Interface; break;
   }
   m.albedo.kind = d.albedo.kind == scene::TextureDesc::Kind::Checker ? Texture::Kind::Checker : Texture::Kind::Constant;
   m.albedo.a = d.albedo.color;

@@ -128,8 +128,10 @@ struct MediumInterfaceDesc {
 
 struct MaterialDesc {
   // Conductor .. Mix: pbrt's materials (scene/material.h, docs/scene-format.md).
+  // Interface: no surface at all (pbrt's "interface"), only a boundary
+  // between media (issue 25: media/, JSON "material": "interface").
   enum class Type { Diffuse, Mirror, Dielectric, Metal, Plastic,
-                    Conductor, RoughDielectric, Uber, Substrate, CoatedDiffuse, CoatedConductor, Mix };
+                    Conductor, RoughDielectric, Uber, Substrate, CoatedDiffuse, CoatedConductor, Mix, Interface };
   Type type = Type::Diffuse;
   std::string name;
   TextureDesc albedo;          // diffuse: reflectance; plastic, uber, substrate, coateddiffuse: base colour

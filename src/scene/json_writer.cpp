@@ -165,6 +165,7 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
   auto rough = [&]() -> Json { return m.roughnessTexture < 0 ? Json(num(m.roughness)) : Json(textures.at(size_t(m.roughnessTexture))); };
   switch (m.type) {
     case T::Diffuse: j["type"] = "diffuse"; albedo(); break;
+    case T::Interface: j["type"] = "interface"; break;
     case T::Mirror: j["type"] = "mirror"; j["color"] = spec; break;
     case T::Dielectric: j["type"] = "dielectric"; j["ior"] = num(m.ior); j["tint"] = spec; break;
     case T::Metal: j["type"] = "metal"; j["color"] = spec; j["roughness"] = rough(); break;

@@ -51,7 +51,8 @@ struct Material {
   // two other materials (resolved by resolveMaterial before any BSDF call).
   enum class Type : uint8_t {
     Diffuse, Mirror, Dielectric, Metal, Plastic,
-    Conductor, RoughDielectric, Uber, Substrate, CoatedDiffuse, CoatedConductor, Mix
+    Conductor, RoughDielectric, Uber, Substrate, CoatedDiffuse, CoatedConductor, Mix,
+    Interface  // no surface: a boundary between media only (no parser makes one yet)
   };
   Type type = Type::Diffuse;
   Texture albedo;            // diffuse reflectance / plastic, uber, substrate, coated-diffuse base colour
