@@ -624,6 +624,15 @@ MotionBounds motionBoundsOver(const Scene& scene, float u0, float u1) {
   // moving area lights' (over the whole shutter: conservative).
   TDPM_ASSERT(scene.movingBounds.size() >= movingObjects, "moving objects' bounds listed first");
   for (size_t i = movingObjects; i < scene.movingBounds.size(); ++i) m.boxes.push_back(scene.movingBounds[i]);
+  // A photon stored on a moving box's face ends its segment exactly on the
+  // bounds' face, where the slab test can miss by a rounding error: the
+  // boxes are grown by a hair (1e-4 of their size, plus the scene's
+  // epsilon) so that such a segment always meets them.
+  for (Bounds3f& b : m.boxes) {
+    Vec3f grow = b.diagonal() * 1e-4f + Vec3f(scene.epsilon(b.center()));
+    b.lo = b.lo - grow;
+    b.hi = b.hi + grow;
+  }
   return m;
 }
 

@@ -315,6 +315,7 @@ class SegmentTimeline {
     for (MapKind kind : kAllMapKinds) {
       if (perShutter_[kind] == 0) continue;
       double rate = pilotRate(shared_.lo, shared_.hi, kind, hashCombine(opt_.seed, 0x5ea7ull, key));
+      blockRate_[kind] = rate;
       if (!(rate > 0)) continue;
       // Paths: sharedScale times a frame's time map's, all kinds of photon
       // counted (the pilot's rate), of which the invariant ones are kept.
@@ -390,9 +391,14 @@ class SegmentTimeline {
     int64_t phase = lo % grid_.binsPerFrame;
     uint64_t key = ao_.independentFrames ? uint64_t(lo) | (uint64_t(1) << 62) : uint64_t(phase);
     const int64_t period = std::clamp<int64_t>((lo + grid_.padBins) / grid_.binsPerFrame, 0, anim_.frames - 1);
+    // Outside every frame's shutter (cut points include every shutter end).
+    const int64_t at = lo - (lo / grid_.binsPerFrame) * grid_.binsPerFrame;
+    const bool pad = at >= grid_.shutterBins;
     for (MapKind kind : kAllMapKinds) {
       if (perShutter_[kind] == 0) continue;
-      double rate = rateFor(period, kind);
+      // Sharing: the block's pilot sizes its segments too (a pilot per
+      // frame period traced more paths than a frame's global map).
+      double rate = shared_.block >= 0 ? blockRate_[kind] : rateFor(period, kind);
       if (!(rate > 0)) continue;
       double share = double(hi - lo) / (double(grid_.binsPerFrame) * anim_.shutterAngle / 360.0);
       // Sharing: only the photons whose path meets the block's motion are
@@ -416,6 +422,12 @@ class SegmentTimeline {
       emitted_ += r.emitted;
       stats_.maps[kind].stored += r.store.size();
       stats_.maps[kind].emitted += r.emitted;
+      stats_.segmentPaths += r.emitted;
+      stats_.segmentPhotons += r.store.size();
+      if (pad) {
+        stats_.padPaths += r.emitted;
+        stats_.padPhotons += r.store.size();
+      }
       seg.stores[kind] = std::move(r.store);
     }
     return seg;
@@ -433,6 +445,7 @@ class SegmentTimeline {
   std::map<std::pair<int64_t, int>, double> rates_;
   std::map<int64_t, Segment> held_;  // by lo
   SharedSet shared_;                 // the current block's (block -1: none)
+  PerMap<double> blockRate_{};       // its pilot's stored photons per path, by kind
   uint64_t emitted_ = 0;
 };
 

@@ -67,6 +67,10 @@ struct AnimationStats {
   uint64_t segmentsTraced = 0;
   uint64_t sharedSets = 0;                    // blocks whose time-invariant photons were traced
   size_t sharedPhotons = 0;                   // time-invariant photons stored, all blocks and kinds
+  // The frames' own segments: paths emitted and photons stored, and those
+  // of the pads (segments outside every shutter: the time kernel's reach).
+  uint64_t segmentPaths = 0, padPaths = 0;
+  size_t segmentPhotons = 0, padPhotons = 0;
   uint64_t passesDone = 0;                    // --progressive: passes of all frames (no segments are traced)
   size_t peakHeldPhotons = 0;                 // segments + the frame's maps, at most
   std::vector<std::string> warnings;
