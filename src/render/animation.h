@@ -57,7 +57,7 @@ struct AnimationOptions {
   // block uses them all. The frames' own segments keep only the photons
   // whose path meets motion, traced with `movingScale` times their paths.
   // sharedScale 0: no sharing (every frame traces all its photons).
-  double sharedScale = 0.0;
+  double sharedScale = 1.0;
   double movingScale = 1.0;
 };
 
