@@ -190,9 +190,8 @@ TEST_CASE("time-invariant photons: no shared photon's path meets the sweep; the 
 
 TEST_CASE("time-invariant photons: energies per unit time in both estimates, against a still plane's irradiance") {
   // The moving plane held still, and the only moving thing a speck above
-  // the light, in a corner of the camera's view (the eye paths test the
-  // whole timeline's bounds: x and z in [-0.06, -0.02] at y = 2.5, where
-  // the view spans +-0.035): eye paths through its swept bounds use
+  // the light, in the camera's view (x and z within +-0.035 at y = 2.5):
+  // eye paths through its swept bounds over the frame's shutter use
   // the time-dependent estimate, the others the standard one, and every
   // photon (light -> plane) is time-invariant, so every frame's estimates
   // come from the shared photons alone, spread over the frame's time map
@@ -201,7 +200,16 @@ TEST_CASE("time-invariant photons: energies per unit time in both estimates, aga
   auto d = test::movingPlaneScene(8);
   d.objects[0].motion = scene::MotionDesc{};
   auto speck = test::sphere(0.0005f, {0, 2.5f, 0}, 0);
-  speck.motion = test::translation({-0.06f, -0.05f, -0.06f}, {-0.02f, 0.05f, -0.02f});
+  // In every frame's shutter [i/4, i/4 + 1/8] it crosses a quarter of the
+  // view, from (-0.035, -0.035) to (0, 0) in x and z, and goes back while
+  // the shutter is closed.
+  for (int i = 0; i <= 4; ++i)
+    for (int half = 0; half < (i < 4 ? 2 : 1); ++half) {
+      speck.motion.times.push_back(float(i) / 4.0f + float(half) / 8.0f);
+      scene::TransformDesc pose;
+      pose.translate = half ? Vec3f{0.0f, 0.0f, 0.0f} : Vec3f{-0.035f, 0.0f, -0.035f};
+      speck.motion.poses.push_back(pose);
+    }
   d.objects.push_back(speck);
   d.animation = scene::AnimationDesc{4.0, 4, 180.0};
   auto s = Scene::build(d);
