@@ -196,7 +196,8 @@ TEST_CASE("time-invariant photons: energies per unit time in both estimates, aga
   // photon (light -> plane) is time-invariant, so every frame's estimates
   // come from the shared photons alone, spread over the frame's time map
   // (energy x map length / block length) and over its shutter (x shutter /
-  // block length). Unscaled, the frames would read 2x to 4x too bright.
+  // block length). Unscaled, the frames would read 2.5x to 4.1x too bright
+  // (block length over map or shutter length).
   auto d = test::movingPlaneScene(8);
   d.objects[0].motion = scene::MotionDesc{};
   auto speck = test::sphere(0.0005f, {0, 2.5f, 0}, 0);
