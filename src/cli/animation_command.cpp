@@ -248,6 +248,14 @@ void printAnimationSummary(const RenderArgs& a, const RenderOptions& opt, const 
     std::fprintf(stderr, "  peak resident memory: %llu bytes\n", static_cast<unsigned long long>(peakRss));
     std::fprintf(stderr, "  peak photons held: %zu\n", stats.peakHeldPhotons);
     std::fprintf(stderr, "  photon pass: %.3f s\n", stats.photonSeconds);
+    if (stats.segmentPaths > 0)
+      std::fprintf(stderr, "  frames' own segments: %llu paths, %zu photons; of them the pads: %llu paths (%.1f%%), %zu photons (%.1f%%)\n",
+                   static_cast<unsigned long long>(stats.segmentPaths), stats.segmentPhotons,
+                   static_cast<unsigned long long>(stats.padPaths), 100.0 * double(stats.padPaths) / double(stats.segmentPaths),
+                   stats.padPhotons, stats.segmentPhotons ? 100.0 * double(stats.padPhotons) / double(stats.segmentPhotons) : 0.0);
+    if (stats.sharedSets > 0)
+      std::fprintf(stderr, "  time-invariant photons: %zu stored in %llu shared sets\n", stats.sharedPhotons,
+                   static_cast<unsigned long long>(stats.sharedSets));
   }
 }
 
@@ -287,6 +295,8 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
   ao.last = f.range.first + int(blockHi) - 1;
   ao.window = a.window.value_or(ao.window);
   ao.independentFrames = a.independentFrames;
+  ao.sharedScale = a.sharedPhotons.value_or(ao.sharedScale);
+  ao.movingScale = a.movingPhotons.value_or(ao.movingScale);
   std::vector<FrameLine> lines;
   uint64_t peakRss = 0;
   Timer frameTimer;

@@ -78,6 +78,8 @@ std::map<std::string, std::string> rankSettings(const RenderArgs& a, const scene
     s["frame_range"] = a.frameRange.value_or("all");
     s["window"] = a.window ? std::to_string(*a.window) : "default";
     s["independent_frames"] = a.independentFrames ? "yes" : "no";
+    s["shared_photons"] = a.sharedPhotons ? exact(*a.sharedPhotons) : "default";
+    s["moving_photons"] = a.movingPhotons ? exact(*a.movingPhotons) : "default";
     s["output"] = a.output;
   }
   return s;

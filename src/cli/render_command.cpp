@@ -35,6 +35,7 @@
 #include "image/png.h"
 #include "import/pbrt_import.h"
 #include "photon/store.h"
+#include "render/animation.h"
 #include "render/film_output.h"
 #include "render/progressive.h"
 #include "render/renderer.h"
@@ -51,6 +52,13 @@ namespace limits = scene::limits;
 static_assert(limits::kTimeBins == photon::kTimeBins, "the kappa range in scene/limits.h assumes the photon time bins");
 
 std::string methodList() { return renderMethodList(); }
+
+// A default value for a flag's help text (1, 0.25).
+std::string shortNumber(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
 
 // pbrt's Film "filename" (often .exr, .png or .pfm): tdpm writes EXR, so
 // the name keeps its directory and stem and gets the .exr extension.
@@ -431,6 +439,14 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_flag("--independent-frames", a.independentFrames, "Seed every frame's photons independently (default: "
               "corresponding photon paths of every frame share random numbers, so still lighting does not flicker)")
       ->group(animationGroup);
+  c->add_option("--shared-photons", a.sharedPhotons, "Time-invariant photons (paths from still lights that miss "
+                "everything moving) traced once per block of --window frames, with this many times one frame's "
+                "paths, and used by every frame of the block; 0: none shared (default "
+                + shortNumber(AnimationOptions{}.sharedScale) + ")")
+      ->check(CLI::Range(0.0, 1000.0))->group(animationGroup);
+  c->add_option("--moving-photons", a.movingPhotons, "With --shared-photons: each frame traces this many times its "
+                "paths for the photons whose path meets motion (default " + shortNumber(AnimationOptions{}.movingScale) + ")")
+      ->check(CLI::Range(0.001, 1000.0))->group(animationGroup);
   addProgressiveOptions(c, a);
   return c;
 }
@@ -551,11 +567,13 @@ ProgressiveState startProgressiveState(const RenderArgs& a, const RenderSetup& s
 
 // The animation flags on a scene without an animation block.
 void refuseAnimationFlags(const RenderArgs& a, bool framePattern) {
-  if (framePattern || a.frameRange || a.video || a.window || a.independentFrames)
+  if (framePattern || a.frameRange || a.video || a.window || a.independentFrames || a.sharedPhotons || a.movingPhotons)
     throw Error(std::string(framePattern ? "--output: a frame-number pattern (#)"
                             : a.frameRange ? "--frame-range"
                             : a.video      ? "--video"
                             : a.window     ? "--window"
+                            : a.sharedPhotons ? "--shared-photons"
+                            : a.movingPhotons ? "--moving-photons"
                                            : "--independent-frames") +
                 " needs an animation, but " + a.scene + " has no \"animation\" block (docs/scene-format.md)");
 }

@@ -38,6 +38,7 @@ struct RenderArgs {
   std::optional<std::string> frameRange, video;
   std::optional<int> window;
   bool independentFrames = false;
+  std::optional<double> sharedPhotons, movingPhotons;  // --shared-photons, --moving-photons
   // progressive passes (cli/progressive_options.h)
   bool progressive = false;
   bool fixedBudget = false;  // --fixed-budget: overrides render.progressive of the scene

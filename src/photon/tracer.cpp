@@ -426,6 +426,10 @@ struct Tracer {
       Vec2f uDir = rng.get2D(dims::kPhotonDirection);
       if (!emitFromLight(light, time01, scene.bounds, uPos, uDir, ray)) return rays;
     }
+    // Time-invariant so far (settings.invariant != All): a still light, and
+    // every segment up to here misses what moves over the window.
+    bool invariant = settings.invariant != InvariantPhotons::All && !light.motion.moving();
+    if (settings.invariant == InvariantPhotons::Only && !invariant) return rays;
     Rgb power = ray.flux / lights.pdf[li];
     float time = scene.shutter.instant() ? t0 : scene.shutter.fromNormalized(time01);
     // Off the emitter's surface: an area light is geometry, and a photon
@@ -437,13 +441,18 @@ struct Tracer {
       Hit hit;
       ++rays;
       if (!scene.intersect(origin, dir, std::numeric_limits<float>::infinity(), time01, hit)) return rays;
+      if (invariant && settings.motion->meets(origin, dir, hit.t)) {
+        invariant = false;
+        if (settings.invariant == InvariantPhotons::Only) return rays;  // nothing further is invariant
+      }
       if (hit.isLight()) return rays;  // emitters absorb
       const Material& mat = resolveMaterial(scene.materials.data(), scene.objects[hit.object].material, hit.p, -dir);
       // A sharp metal continues a caustic path (after storing there: the
       // caustic seen on the metal itself is L S+ G).
       bool glossyBounce = settings.glossyCaustics && mat.isGlossy();
       if (!mat.isDeltaOnly()) {
-        bool store = settings.kind == MapKind::Global || (bounce > 0 && allSpecular);
+        bool store = (settings.kind == MapKind::Global || (bounce > 0 && allSpecular)) &&
+                     (settings.invariant != InvariantPhotons::None || !invariant);
         // The side it arrived on keeps it out of estimates on the other side
         // of the same object (photon/surface_tag.h).
         if (store) {
@@ -603,6 +612,30 @@ PhotonStore traceQueuedBatches(const Tracer& tracer, dist::Comm& comm, uint64_t 
 
 }  // namespace
 
+MotionBounds motionBoundsOver(const Scene& scene, float u0, float u1) {
+  MotionBounds m;
+  size_t movingObjects = 0;
+  for (const SceneObject& o : scene.objects)
+    if (o.motion.moving()) {
+      m.boxes.push_back(boundsOver(o, u0, u1));
+      ++movingObjects;
+    }
+  // Scene::build lists the moving objects' swept bounds first, then the
+  // moving area lights' (over the whole shutter: conservative).
+  TDPM_ASSERT(scene.movingBounds.size() >= movingObjects, "moving objects' bounds listed first");
+  for (size_t i = movingObjects; i < scene.movingBounds.size(); ++i) m.boxes.push_back(scene.movingBounds[i]);
+  // A photon stored on a moving box's face ends its segment exactly on the
+  // bounds' face, where the slab test can miss by a rounding error: the
+  // boxes are grown by a hair (1e-4 of their size, plus the scene's
+  // epsilon) so that such a segment always meets them.
+  for (Bounds3f& b : m.boxes) {
+    Vec3f grow = b.diagonal() * 1e-4f + Vec3f(scene.epsilon(b.center()));
+    b.lo = b.lo - grow;
+    b.hi = b.hi + grow;
+  }
+  return m;
+}
+
 void photonTimeRange(const Scene& scene, float& t0, float& t1) {
   t0 = scene.shutter.open;
   t1 = scene.shutter.instant() ? scene.shutter.open + 1.0f : scene.shutter.close;
@@ -652,6 +685,7 @@ TraceResult traceMap(const Scene& scene, const TraceSettings& settings, const Tr
                 t0,
                 t1, ts,
                 uint32_t(mix64(settings.seed ^ 0x7173ull)), u0, u1};
+  TDPM_ASSERT(settings.invariant == InvariantPhotons::All || settings.motion, "time-invariance needs the motion bounds");
   if (settings.storedWanted == 0 || tracer.lights.empty()) return result;
   if (settings.kind == MapKind::Caustic && !sceneHasSpecular(scene, settings.glossyCaustics)) return result;
   const char* stage = settings.kind == MapKind::Caustic ? "caustic photons" : "global photons";

@@ -16,12 +16,41 @@
 
 #include "core/progress.h"
 #include "distributed/comm.h"
+#include "math/bounds.h"
 #include "photon/map_kind.h"
 #include "photon/store.h"
 #include "sampling/sampler.h"
 #include "scene/scene.h"
 
 namespace tdpm::photon {
+
+// Time-invariant photons (animations, docs/animation.md section 7). A
+// photon is time-invariant over a window of time when its light does not
+// move and every segment of its path up to it misses the swept bounds of
+// everything that moves over that window: then the path, and so the light
+// it carries, is the same at every instant of the window. The test is the
+// eye paths' (Scene::segmentMeetsMotion), over the window's bounds.
+struct MotionBounds {
+  std::vector<Bounds3f> boxes;  // each moving object's and area light's, over the window
+  bool meets(Vec3f o, Vec3f d, float tMax) const {
+    if (boxes.empty()) return false;
+    Vec3f inv{1.0f / d.x, 1.0f / d.y, 1.0f / d.z};
+    for (const Bounds3f& b : boxes)
+      if (b.intersectsSegment(o, inv, 0.0f, tMax)) return true;
+    return false;
+  }
+};
+// The swept bounds over normalised times [u0, u1] of the scene's shutter:
+// moving objects' over the interval, moving area lights' over the whole
+// shutter (conservative).
+MotionBounds motionBoundsOver(const Scene& scene, float u0, float u1);
+
+// Which photons a trace keeps (TraceSettings::invariant).
+enum class InvariantPhotons : uint8_t {
+  All,   // every photon, unclassified
+  Only,  // time-invariant photons only (a path ends where it first meets motion)
+  None,  // photons whose path met motion (or whose light moves) only
+};
 
 struct TraceSettings {
   MapKind kind = MapKind::Caustic;
@@ -52,6 +81,11 @@ struct TraceSettings {
   // false: L S+ D with delta surfaces only (the path tracer's guide, whose
   // cones aim at the last delta exit point).
   bool glossyCaustics = true;
+  // Animations: keep photons by whether they are time-invariant over
+  // `motion` (required unless All). Emission counts and energies are as for
+  // All: the kept photons are exactly those All would store of their kind.
+  InvariantPhotons invariant = InvariantPhotons::All;
+  const MotionBounds* motion = nullptr;
 };
 
 // What one caller alone adds to a trace: each has its own entry point below.

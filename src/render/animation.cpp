@@ -53,11 +53,53 @@ std::vector<int64_t> cutPoints(const TimeGrid& g, int frames, int first, int las
 
 bool inside(int64_t lo, int64_t hi, int64_t a, int64_t b) { return lo >= a && hi <= b; }
 
+// The time-invariant photons of one block of frames (docs/animation.md
+// section 7): traced once over the block's time [lo, hi) (bins, clipped to
+// the timeline), energies Q = Phi (hi - lo) w / n over it, times uniform
+// over it (the store's 256 bins span it). A frame spreads them over its own
+// map's time with energies scaled to that length (frameMap).
+struct SharedSet {
+  int block = -1;
+  int64_t lo = 0, hi = 0;
+  photon::MotionBounds motion;  // swept bounds of what moves during [lo, hi)
+  PerMap<photon::PhotonStore> stores;
+  size_t size() const {
+    size_t n = 0;
+    for (MapKind k : kAllMapKinds) n += stores[k].size();
+    return n;
+  }
+};
+
+// A shared photon's energy scaled to a part of its block's time (RGBE
+// re-encoded: rounded to nearest, zero-mean error as the store's own).
+uint32_t scaledEnergy(uint32_t rgbe, float factor) { return photon::encodeRgbe(photon::decodeRgbe(rgbe) * factor); }
+
+// The shared set's photons into frame `frame`'s two stores: over the time
+// map's covered bins [c0, c1) with energy x (c1 - c0) / (block length), and
+// into the shutter's store with energy x S / (block length), each keeping
+// its place q of 256 in the block's time (uniform and independent of where
+// it lies: the density in time of light that does not change).
+void addShared(const SharedSet& sh, MapKind kind, const TimeGrid& g, int64_t lo, int64_t c0, int64_t c1,
+               photon::PhotonStore& all, photon::PhotonStore& own) {
+  const photon::PhotonStore& st = sh.stores[kind];
+  const double block = double(sh.hi - sh.lo);
+  const float toMap = float(double(c1 - c0) / block), toShutter = float(double(g.shutterBins) / block);
+  for (size_t p = 0; p < st.size(); ++p) {
+    const int64_t q = st.timeBin(p);
+    all.addEncoded(st.xs()[p], st.ys()[p], st.zs()[p], scaledEnergy(st.energies()[p], toMap), st.directions()[p],
+                   st.flags()[p], uint8_t(c0 - lo + q * (c1 - c0) / photon::kTimeBins));
+    own.addEncoded(st.xs()[p], st.ys()[p], st.zs()[p], scaledEnergy(st.energies()[p], toShutter), st.directions()[p],
+                   st.flags()[p], uint8_t(q));
+  }
+}
+
 // Frame i's map of one kind: every photon of the segments inside its time
 // map, re-binned on the frame's 256 bins (an integer shift: same grid), and
 // a 3D tree of its shutter's photons alone for the standard estimate.
-std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments, MapKind kind, const TimeGrid& g,
-                                    int frame, bool spaceTime, float kappa) {
+// With a shared set, its time-invariant photons join both (addShared).
+std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments, const SharedSet* shared,
+                                    MapKind kind, const TimeGrid& g, int frame, int64_t timelineEnd, bool spaceTime,
+                                    float kappa) {
   const int64_t lo = g.mapLo(frame), hi = g.mapHi(frame);
   const int64_t s0 = int64_t(frame) * g.binsPerFrame, s1 = s0 + g.shutterBins;
   auto map = std::make_unique<PhotonMap>();
@@ -70,8 +112,10 @@ std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments,
     nAll += n;
     if (inside(s->lo, s->hi, s0, s1)) nOwn += n;
   }
-  all.reserve(nAll);
-  own.reserve(nOwn);
+  const size_t nShared = shared ? shared->stores[kind].size() : 0;
+  all.reserve(nAll + nShared);
+  own.reserve(nOwn + nShared);
+  if (shared) addShared(*shared, kind, g, lo, std::max<int64_t>(lo, 0), std::min(hi, timelineEnd), all, own);
   for (const Segment* s : segments) {
     if (!inside(s->lo, s->hi, lo, hi)) continue;
     const photon::PhotonStore& st = s->stores[kind];
@@ -193,14 +237,17 @@ void addWarning(AnimationStats& stats, const std::string& w) {
 
 // Memory: the window's segments (each frame's shutter and pads) and one
 // frame's two copies of its maps, at --photons per shutter.
+// With sharing, the block's shared set too (sharedScale frames' maps, held
+// once and copied into each frame's maps).
 void checkAnimationMemory(const Scene& scene, const RenderOptions& opt, const TimeGrid& grid, int window,
-                          int windowFlag, bool photons) {
+                          int windowFlag, bool photons, double sharedScale) {
   if (!photons) {
     checkMemoryBudget(scene, opt, tbb::this_task_arena::max_concurrency(), availableMemoryBytes());
     return;
   }
   RenderOptions held = opt;
-  double factor = double(window + 2) * double(grid.shutterBins + 2 * grid.padBins) / double(grid.shutterBins) + 1.0;
+  const double mapShare = double(grid.shutterBins + 2 * grid.padBins) / double(grid.shutterBins);
+  double factor = double(window + 2) * mapShare + 1.0 + 3.0 * sharedScale * mapShare;
   // The budget's message names what multiplied the scene's counts.
   const std::string times = " per frame, held for a window of " + std::to_string(window) +
                             " frames at once (--window " + std::to_string(windowFlag) + ")";
@@ -243,13 +290,65 @@ class SegmentTimeline {
       it = it->second.hi <= grid_.mapLo(frame) ? held_.erase(it) : std::next(it);
   }
 
+  // Time-invariant photons (ao.sharedScale > 0): the block of frames
+  // [jK, (j+1)K) that `frame` is in (K = ao.window as given, so a frame's
+  // image does not depend on the range a run renders), its shared set
+  // traced when first needed. Segments classified for another block are
+  // freed: which of their photons are kept depends on the block's motion.
+  void enterBlock(int frame) {
+    const int block = frame / ao_.window;
+    if (shared_.block == block) return;
+    held_.clear();
+    shared_ = SharedSet{};
+    shared_.block = block;
+    const int f0 = block * ao_.window, f1 = int(std::min<int64_t>(anim_.frames - 1, int64_t(f0) + ao_.window - 1));
+    const int64_t end = int64_t(anim_.frames) * grid_.binsPerFrame;
+    shared_.lo = std::max<int64_t>(0, grid_.mapLo(f0));
+    shared_.hi = std::min(end, grid_.mapHi(f1));
+    const float t0 = float(double(shared_.lo) * grid_.binWidth), t1 = float(double(shared_.hi) * grid_.binWidth);
+    shared_.motion = photon::motionBoundsOver(scene_, scene_.shutter.normalized(t0), scene_.shutter.normalized(t1));
+    // Seeded alike for every block (common random numbers: the same paths,
+    // so still light does not change between blocks) unless
+    // --independent-frames.
+    const uint64_t key = ao_.independentFrames ? uint64_t(block) : 0;
+    const double mapShare = double(grid_.shutterBins + 2 * grid_.padBins) / double(grid_.shutterBins);
+    for (MapKind kind : kAllMapKinds) {
+      if (perShutter_[kind] == 0) continue;
+      double rate = pilotRate(shared_.lo, shared_.hi, kind, hashCombine(opt_.seed, 0x5ea7ull, key));
+      blockRate_[kind] = rate;
+      if (!(rate > 0)) continue;
+      // Paths: sharedScale times a frame's time map's, all kinds of photon
+      // counted (the pilot's rate), of which the invariant ones are kept.
+      photon::TraceSettings ts = traceSettingsFor(
+          opt_, kind, size_t(std::max(1.0, std::round(double(perShutter_[kind]) * mapShare * ao_.sharedScale))),
+          hashCombine(opt_.seed, 0x5a4edull, key));
+      ts.timeOpen = t0;
+      ts.timeClose = t1;
+      ts.invariant = photon::InvariantPhotons::Only;
+      ts.motion = &shared_.motion;
+      photon::SegmentStore grid;
+      grid.storeT0 = t0;
+      grid.storeT1 = t1;
+      grid.storedPerPath = rate;
+      photon::TraceResult r = photon::traceSegmentPhotons(scene_, ts, grid, framed_);
+      addWarning(stats_, r.warning);
+      emitted_ += r.emitted;
+      stats_.maps[kind].stored += r.store.size();
+      stats_.maps[kind].emitted += r.emitted;
+      stats_.sharedPhotons += r.store.size();
+      shared_.stores[kind] = std::move(r.store);
+    }
+    ++stats_.sharedSets;
+  }
+  const SharedSet* shared() const { return shared_.block >= 0 ? &shared_ : nullptr; }
+
   std::vector<const Segment*> segments() const {
     std::vector<const Segment*> segs;
     for (const auto& [lo, s] : held_) segs.push_back(&s);
     return segs;
   }
   size_t heldPhotons() const {
-    size_t n = 0;
+    size_t n = shared_.size();
     for (const auto& [lo, s] : held_) n += s.size();
     return n;
   }
@@ -265,13 +364,20 @@ class SegmentTimeline {
     auto it = rates_.find(key);
     if (it != rates_.end()) return it->second;
     const int64_t timelineEnd = int64_t(anim_.frames) * grid_.binsPerFrame;
-    photon::TraceSettings ts = traceSettingsFor(opt_, kind, 1, hashCombine(opt_.seed, 0x9170ull, uint64_t(period)));
     int frame = int(std::clamp<int64_t>(period, 0, anim_.frames - 1));
-    ts.timeOpen = float(double(std::max<int64_t>(0, grid_.mapLo(frame))) * grid_.binWidth);
-    ts.timeClose = float(double(std::min(timelineEnd, grid_.mapHi(frame))) * grid_.binWidth);
+    return rates_[key] = pilotRate(std::max<int64_t>(0, grid_.mapLo(frame)), std::min(timelineEnd, grid_.mapHi(frame)),
+                                   kind, hashCombine(opt_.seed, 0x9170ull, uint64_t(period)));
+  }
+
+  // Stored photons per path of every kind's photons (InvariantPhotons::All)
+  // over bins [lo, hi).
+  double pilotRate(int64_t lo, int64_t hi, MapKind kind, uint64_t seed) {
+    photon::TraceSettings ts = traceSettingsFor(opt_, kind, 1, seed);
+    ts.timeOpen = float(double(lo) * grid_.binWidth);
+    ts.timeClose = float(double(hi) * grid_.binWidth);
     photon::TraceResult r = photon::tracePhotons(scene_, ts, Progress{});
     addWarning(stats_, r.warning);
-    return rates_[key] = r.storedPerPath;
+    return r.storedPerPath;
   }
 
   Segment traceSegment(int64_t lo, int64_t hi) {
@@ -285,16 +391,28 @@ class SegmentTimeline {
     int64_t phase = lo % grid_.binsPerFrame;
     uint64_t key = ao_.independentFrames ? uint64_t(lo) | (uint64_t(1) << 62) : uint64_t(phase);
     const int64_t period = std::clamp<int64_t>((lo + grid_.padBins) / grid_.binsPerFrame, 0, anim_.frames - 1);
+    // Outside every frame's shutter (cut points include every shutter end).
+    const int64_t at = lo - (lo / grid_.binsPerFrame) * grid_.binsPerFrame;
+    const bool pad = at >= grid_.shutterBins;
     for (MapKind kind : kAllMapKinds) {
       if (perShutter_[kind] == 0) continue;
-      double rate = rateFor(period, kind);
+      // Sharing: the block's pilot sizes its segments too (a pilot per
+      // frame period traced more paths than a frame's global map).
+      double rate = shared_.block >= 0 ? blockRate_[kind] : rateFor(period, kind);
       if (!(rate > 0)) continue;
       double share = double(hi - lo) / (double(grid_.binsPerFrame) * anim_.shutterAngle / 360.0);
+      // Sharing: only the photons whose path meets the block's motion are
+      // kept (the shared set has the others), from movingScale x the paths.
+      if (shared_.block >= 0) share *= ao_.movingScale;
       photon::TraceSettings ts =
           traceSettingsFor(opt_, kind, size_t(std::max(1.0, std::round(double(perShutter_[kind]) * share))),
                            hashCombine(opt_.seed, key, uint64_t(hi - lo)));
       ts.timeOpen = float(double(lo) * grid_.binWidth);
       ts.timeClose = float(double(hi) * grid_.binWidth);
+      if (shared_.block >= 0) {
+        ts.invariant = photon::InvariantPhotons::None;
+        ts.motion = &shared_.motion;
+      }
       photon::SegmentStore grid;  // the timeline's bins, and the period's measured rate
       grid.storeT0 = ts.timeOpen;
       grid.storeT1 = float(double(lo + photon::kTimeBins) * grid_.binWidth);
@@ -304,6 +422,12 @@ class SegmentTimeline {
       emitted_ += r.emitted;
       stats_.maps[kind].stored += r.store.size();
       stats_.maps[kind].emitted += r.emitted;
+      stats_.segmentPaths += r.emitted;
+      stats_.segmentPhotons += r.store.size();
+      if (pad) {
+        stats_.padPaths += r.emitted;
+        stats_.padPhotons += r.store.size();
+      }
       seg.stores[kind] = std::move(r.store);
     }
     return seg;
@@ -320,6 +444,8 @@ class SegmentTimeline {
   const std::vector<int64_t> cuts_;
   std::map<std::pair<int64_t, int>, double> rates_;
   std::map<int64_t, Segment> held_;  // by lo
+  SharedSet shared_;                 // the current block's (block -1: none)
+  PerMap<double> blockRate_{};       // its pilot's stored photons per path, by kind
   uint64_t emitted_ = 0;
 };
 
@@ -335,8 +461,9 @@ void renderTimelineFrame(const Scene& scene, const scene::AnimationDesc& anim, c
   if (photons) {
     Timer mapTimer;
     std::vector<const Segment*> segs = timeline.segments();
+    const int64_t end = int64_t(anim.frames) * grid.binsPerFrame;
     for (MapKind k : kAllMapKinds) {
-      maps[k] = frameMap(segs, k, grid, frame, spaceTime, opt.kappa);
+      maps[k] = frameMap(segs, timeline.shared(), k, grid, frame, end, spaceTime, opt.kappa);
       in.maps[k] = maps[k].get();
       heldNow += maps[k]->store.size() + maps[k]->store3.size();
     }
@@ -377,7 +504,7 @@ AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& a
   // photons). Frames' photons do not depend on the window, so capping it
   // changes no image.
   const int window = int(std::min<int64_t>(ao.window, int64_t(total)));
-  checkAnimationMemory(scene, opt, grid, window, ao.window, photons);
+  checkAnimationMemory(scene, opt, grid, window, ao.window, photons, photons ? ao.sharedScale : 0.0);
 
   std::string prefix;
   Progress framed;
@@ -386,9 +513,13 @@ AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& a
   SegmentTimeline timeline(scene, anim, opt, ao, grid, photons ? photonsWanted(opt) : PerMap<size_t>{}, framed, stats);
 
   progress.at(WorkPosition{"frame", 0, total, 0, 0});
-  for (int w0 = ao.first; w0 <= ao.last; w0 += window) {
-    const int w1 = std::min(ao.last, w0 + window - 1);
+  const bool share = photons && ao.sharedScale > 0;
+  for (int w0 = ao.first; w0 <= ao.last;) {
+    // Sharing: windows are the blocks of ao.window frames from frame 0
+    // (clipped to the range), each with its shared set.
+    const int w1 = share ? std::min(ao.last, (w0 / ao.window + 1) * ao.window - 1) : std::min(ao.last, w0 + window - 1);
     Timer traceTimer;
+    if (share) timeline.enterBlock(w0);
     if (photons) timeline.traceWindow(w0, w1);
     stats.photonSeconds += traceTimer.seconds();
     for (int i = w0; i <= w1; ++i) {
@@ -397,6 +528,7 @@ AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& a
       progress.at(WorkPosition{"frame", size_t(i - ao.first + 1), total, 0, timeline.emitted()});
     }
     timeline.releaseBefore(w1 + 1);
+    w0 = w1 + 1;
   }
   return stats;
 }

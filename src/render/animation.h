@@ -49,12 +49,28 @@ struct AnimationOptions {
   // so corresponding paths of every frame share random numbers and still
   // lighting does not flicker (docs/animation.md).
   bool independentFrames = false;
+  // Time-invariant photons (docs/animation.md section 7): frames are taken
+  // in blocks of `window` from frame 0 (frames [jK, (j+1)K), whatever range
+  // a run renders); the photons whose path misses everything that moves
+  // over a block's time are traced once for the block, with `sharedScale`
+  // times the paths one frame's time map traces, and every frame of the
+  // block uses them all. The frames' own segments keep only the photons
+  // whose path meets motion, traced with `movingScale` times their paths.
+  // sharedScale 0: no sharing (every frame traces all its photons).
+  double sharedScale = 1.0;
+  double movingScale = 1.0;
 };
 
 struct AnimationStats {
   double photonSeconds = 0;                   // tracing, and building frame maps
   PerMap<MapStats> maps;                      // stored and emitted per map kind
   uint64_t segmentsTraced = 0;
+  uint64_t sharedSets = 0;                    // blocks whose time-invariant photons were traced
+  size_t sharedPhotons = 0;                   // time-invariant photons stored, all blocks and kinds
+  // The frames' own segments: paths emitted and photons stored, and those
+  // of the pads (segments outside every shutter: the time kernel's reach).
+  uint64_t segmentPaths = 0, padPaths = 0;
+  size_t segmentPhotons = 0, padPhotons = 0;
   uint64_t passesDone = 0;                    // --progressive: passes of all frames (no segments are traced)
   size_t peakHeldPhotons = 0;                 // segments + the frame's maps, at most
   std::vector<std::string> warnings;

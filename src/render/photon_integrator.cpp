@@ -186,7 +186,7 @@ Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, flo
           sum += beta * environmentEmission(scene_, d, bs.pdf, s_.gatherRays, false);
         break;
       }
-      moved = moved || scene_.segmentMeetsMotion(o, d, h.t);
+      moved = moved || meetsMotion(o, d, h.t);
       if (h.isLight()) {
         // Seen straight from the gather point: the BSDF-sampled half of
         // direct light (MIS with the shadow rays). Through mirrors or
@@ -297,7 +297,7 @@ Rgb PhotonIntegrator::traceFrom(Vec3f origin, Vec3f dir, float time01, EyeVertex
       break;
     }
     pathLength += hit.t;
-    touched = touched || scene_.segmentMeetsMotion(origin, dir, hit.t);
+    touched = touched || meetsMotion(origin, dir, hit.t);
     if (hit.isLight()) {
       // Seen through mirrors/glass only, or straight from a sharp metal:
       // shadow rays cannot (or, from the metal, share it by MIS).

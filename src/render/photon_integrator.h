@@ -48,6 +48,10 @@ struct PhotonIntegratorSettings {
   // one over the whole shutter elsewhere (the skip rule).
   bool fixedKernels = false;
   PerMap<estimate::MapKernel> kernels;
+  // Animation frames (render/animation.h): whether an eye path meets motion
+  // is tested against what moves during the frame's shutter, not the whole
+  // timeline (null: Scene::segmentMeetsMotion, the shutter's bounds).
+  const photon::MotionBounds* eyeMotion = nullptr;
 };
 
 struct EstimateCounts {
@@ -98,6 +102,10 @@ class PhotonIntegrator {
   EstimateCounts counts() const;
 
  private:
+  // The eye paths' motion test (PhotonIntegratorSettings::eyeMotion).
+  bool meetsMotion(Vec3f o, Vec3f d, float tMax) const {
+    return s_.eyeMotion ? s_.eyeMotion->meets(o, d, tMax) : scene_.segmentMeetsMotion(o, d, tMax);
+  }
   Rgb estimate(const PhotonMap* map, std::unique_ptr<estimate::Gatherer>& g, std::unique_ptr<estimate::Gatherer>& g3,
                const Hit& hit, const struct ShadingContext& ctx, Vec3f wo, float time01, bool timeDependent,
                ThreadState& ts, float minVolume = 0.0f) const;
