@@ -58,7 +58,7 @@ const Film& reference() {
   return ref;
 }
 
-Film photonRender(bool fourD, size_t globalPhotons, int spp, uint64_t seed, float guide) {
+Film photonRender(bool fourD, size_t globalPhotons, int spp, uint64_t seed, bool guide = true) {
   RenderOptions o = test::smallRenderOptions(RenderMethod::Time, spp, 16, seed);
   o.progressive = false;
   o.spaceTime4D = fourD;
@@ -76,7 +76,7 @@ Film photonRender(bool fourD, size_t globalPhotons, int spp, uint64_t seed, floa
 TEST_CASE("sparse room: time (two-pass and 4D) with 5,000 global photons within 3% of the path tracer") {
   const double ref = meanOutsideLamp(reference());
   for (bool fourD : {false, true}) {
-    double ratio = meanOutsideLamp(photonRender(fourD, 5000, 32, 3, 0.0f)) / ref;
+    double ratio = meanOutsideLamp(photonRender(fourD, 5000, 32, 3)) / ref;
     MESSAGE(std::string(fourD ? "4D" : "two-pass") << " / pathtrace: " << ratio);
     CHECK(ratio == doctest::Approx(1.0).epsilon(0.03));
   }
@@ -94,8 +94,8 @@ TEST_CASE("sparse room: the gather guide removes the final gather's salt, and ke
   const Film& ref = reference();
   image::ImageRgb r = toImage(ref);
   image::PixelRect all{0, 0, kW, kH};
-  Film off = photonRender(false, 50000, 16, 4, 0.0f);
-  Film on = photonRender(false, 50000, 16, 4, 0.5f);
+  Film off = photonRender(false, 50000, 16, 4, false);
+  Film on = photonRender(false, 50000, 16, 4);
   double saltOff = image::countSalt(toImage(off), r, all).share;
   double saltOn = image::countSalt(toImage(on), r, all).share;
   double meanOff = meanOutsideLamp(off) / meanOutsideLamp(ref), meanOn = meanOutsideLamp(on) / meanOutsideLamp(ref);

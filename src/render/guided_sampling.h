@@ -34,20 +34,38 @@ struct GuideCones {
     Vec3f axis;
     float oneMinusCos;
     float solidAngle;
+    float density = 0.0f;  // perCone: 1 / (count x solidAngle)
     bool holds(Vec3f w) const { return lengthSquared(w - axis) <= 2.0f * oneMinusCos; }
   };
   std::array<Cone, kMaxCones> cone;
   int count = 0;
   float totalSolidAngle = 0;
   float fraction = 0;  // c; 0 when there is no cone
+  // false: a cone is picked in proportion to its solid angle (the caustic
+  // guide's equal cones), density c N(w) / Omega. true: each cone is picked
+  // with probability 1 / count whatever its size (the gather guide's cones
+  // of per-photon widths, one per photon of about equal flux), density
+  // c sum over the cones holding w of 1 / (count Omega_i).
+  bool perCone = false;
+  // Multi-sample MIS (Veach's balance heuristic over one BSDF sample and
+  // one guide sample, guidedPairSample): the density a sample is weighed by
+  // is p_bsdf + p_guide, and c only switches the guide on.
+  bool multi = false;
 
   bool active() const { return fraction > 0.0f; }
   // Mixture density of direction w, given the BSDF's density of it.
   float pdf(float bsdfPdf, Vec3f w) const {
     if (!active()) return bsdfPdf;
+    if (perCone) {
+      float g = 0.0f;
+      for (int i = 0; i < count; ++i)
+        if (cone[size_t(i)].holds(w)) g += cone[size_t(i)].density;
+      return multi ? bsdfPdf + g : (1.0f - fraction) * bsdfPdf + fraction * g;
+    }
     int inside = 0;
     for (int i = 0; i < count; ++i) inside += cone[size_t(i)].holds(w);
-    return (1.0f - fraction) * bsdfPdf + fraction * float(inside) / totalSolidAngle;
+    float g = float(inside) / totalSolidAngle;
+    return multi ? bsdfPdf + g : (1.0f - fraction) * bsdfPdf + fraction * g;
   }
 };
 
@@ -57,5 +75,14 @@ struct GuideCones {
 // lobe choice, so no sample dimension is added. out.weight = f |cos| / p(w),
 // out.pdf = p(w). Without an active guide this is bsdfSample itself.
 bool guidedBsdfSample(const ShadingContext& ctx, const GuideCones& cones, Vec2f u, float uLobe, BsdfSample& out);
+
+// With cones.multi: sample `which` (0: the BSDF's, 1: the guide's) of a
+// pair whose two values, each f |cos| / (p_bsdf + p_guide), sum to an
+// unbiased estimate of the integral (the balance heuristic with one sample
+// per strategy). Where the guide has no density the BSDF sample alone
+// carries f |cos| / p_bsdf, as without a guide: a guide that misses adds no
+// variance there (the one-sample mixture doubled the weight in its gaps).
+bool guidedPairSample(const ShadingContext& ctx, const GuideCones& cones, int which, Vec2f u, float uLobe,
+                      BsdfSample& out);
 
 }  // namespace tdpm
