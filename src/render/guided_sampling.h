@@ -1,6 +1,7 @@
-// render/guided_sampling.h — the path tracer's one-sample mixture of BSDF
-// sampling and a guide made of cones of directions (render/caustic_guide.h
-// fills the cones from caustic photons).
+// render/guided_sampling.h — sampling with a guide made of cones of
+// directions: the path tracer's one-sample mixture with BSDF sampling
+// (render/caustic_guide.h fills the cones from caustic photons) and the
+// final gather's BSDF/guide pair (its cones from global photons).
 //
 // With probability c a direction is drawn uniformly from one cone (chosen
 // in proportion to its solid angle), otherwise from the BSDF. The density
@@ -12,6 +13,13 @@
 // decide how much variance is saved. Next-event estimation's MIS weight
 // uses the same p(w) for the BSDF side (render/direct_light.h), and so does
 // the emission a continuation ray hits.
+//
+// The final gather (render/photon_integrator.cpp) uses the cones another
+// way: each gather ray is a pair, one BSDF sample and one guide sample,
+// each weighed by p_bsdf(w) + p_guide(w) (multi-sample MIS, balance
+// heuristic; guidedPairSample), with cones of per-photon widths each drawn
+// with probability 1/count (perCone). In a gap between cones the mixture
+// doubles a BSDF sample's weight (at c = 0.5); the pair leaves it as it is.
 //
 // No cones (fraction 0) means plain BSDF sampling, drawn and weighed
 // exactly as without a guide.
