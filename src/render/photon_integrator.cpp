@@ -27,8 +27,8 @@ constexpr uint32_t kGuideSub = 1u << 16;  // finalGather: the guide samples' kGa
 // error and than the spread of directions toward a bright patch a few metres
 // away across one estimate's disc (with fixed 0.2-rad cones: 0.08 rad left
 // 4x the salt on scenes/sparse-room.json). Measured (docs/photon-map.md):
-// the 4th-nearest photon gave 2x the salt on sparse-room, fixed 0.2-rad
-// cones 10-30% more noise on the moving static-room.
+// widths to the 4th-nearest photon gave 1.5x the salt on sparse-room, fixed
+// 0.2-rad cones 20% more noise than these on the moving static-room.
 constexpr int kGuideNeighbours = 2;
 constexpr float kGuideMinOneMinusCos = 0.019933f;  // 1 - cos(0.2)
 constexpr float kGuideMaxOneMinusCos = 0.459698f;  // 1 - cos(1)
@@ -172,8 +172,9 @@ void PhotonIntegrator::gatherCones(const Hit& hit, const ShadingContext& ctx, fl
   const int n = cones.count;
   if (n == 0) return;
   // Each cone's half-angle: the angle to its photon's kGuideNeighbours-th
-  // nearest other photon, in [kGuideMinAngle, kGuideMaxAngle]. The top
-  // kGuideNeighbours cosines per photon, from each pair's one dot product.
+  // nearest other photon, held in [0.2, 1] rad (kGuideMin/MaxOneMinusCos).
+  // The top kGuideNeighbours cosines per photon, from each pair's one dot
+  // product.
   std::array<std::array<float, kGuideNeighbours>, GuideCones::kMaxCones> near;
   for (auto& r : near) r.fill(-1.0f);
   auto offer = [&near](int i, float d) {
