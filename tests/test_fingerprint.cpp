@@ -110,7 +110,7 @@ TEST_CASE("fingerprint: every image-changing option changes it, and is named") {
       {"kernel_footprint", [](RenderOptions& o) { o.kernelFootprint = 2.0f; }},
       {"alpha", [](RenderOptions& o) { o.alpha = 0.5f; }},
       {"extra_samples", [](RenderOptions& o) { o.passExtraSamples = 0.5f; }},
-      {"gather_guide", [](RenderOptions& o) { o.gatherGuide = 0.5f; }},
+      {"gather_guide", [](RenderOptions& o) { o.gatherGuide = false; }},
       {"direct_only", [](RenderOptions& o) { o.directOnly = true; }},
       // The smallest change a float can have: still seen.
       {"contrast", [](RenderOptions& o) { o.contrast = std::nextafter(o.contrast, 1.0f); }},

@@ -273,7 +273,7 @@ RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc,
   o.estimate.spaceKernel = spaceKernelFrom(pick(a.kernelSpace, sc.kernelSpace, std::string("uniform")));
   o.estimate.timeKernel = timeKernelFrom(pick(a.kernelTime, sc.kernelTime, std::string("uniform")));
   o.gatherRays = pick(a.gather, sc.gather, o.gatherRays);
-  o.gatherGuide = a.gatherGuide.value_or(o.gatherGuide);
+  if (a.gatherGuide) o.gatherGuide = *a.gatherGuide == "on";
   o.visualizeGlobal = a.globalDirect;
   // For the memory-budget error: name what set each count.
   if (!a.photons && sc.photons) o.causticPhotonsSource = "render.photons in " + sourcePath;
@@ -418,13 +418,12 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_option("--gather", a.gather, "Final-gather rays per sample for indirect light; 0: none (default 1)")
       ->check(rangeOf(limits::kGather))->group(photonGroup);
   c->add_option("--gather-guide", a.gatherGuide,
-                "Fixed budget: share of the final-gather rays aimed along the incoming directions of the 32 global "
-                "photons nearest the gather point (Jensen 1995; an unbiased mixture with the BSDF: a bright patch "
-                "no longer salts the image); no cone toward a light; not used under a non-black background, whose light has "
-                "no photons. Helps where a small bright patch lights a large room (sparse-room: salt 0.82% -> 0.03%); "
-                "doubles the noise of an evenly lit small room (static-room); default 0 (off), 0.5 where it helps "
-                "(docs/photon-map.md)")
-      ->check(rangeOf(limits::kGatherGuide))->group(photonGroup);
+                "Fixed budget: each final-gather ray is a pair, one BSDF-sampled and one aimed along the incoming "
+                "direction of one of the 32 global photons nearest the gather point (Jensen 1995; balance heuristic, "
+                "unbiased): a bright patch beside a lamp no longer salts a large room (sparse-room: salt 0.82% -> "
+                "0.04%); no cone toward a light; not used under a non-black background, whose light has no photons; "
+                "on or off (default on; docs/photon-map.md)")
+      ->check(CLI::IsMember({"on", "off"}))->group(photonGroup);
   c->add_flag("--global-direct", a.globalDirect, "Show the global photon map directly at the first diffuse hit (debugging, tests)")
       ->group(photonGroup);
   const std::string animationGroup = "Animations (scenes with an \"animation\" block, docs/animation.md)";

@@ -18,7 +18,8 @@ struct RenderArgs {
   std::string output;  // default: <scene stem>.exr in the working directory
   std::optional<std::string> method;
   std::optional<int> spp, maxSpp, maxDepth;
-  std::optional<float> causticGuiding, gatherGuide;
+  std::optional<float> causticGuiding;
+  std::optional<std::string> gatherGuide;  // "on" / "off"
   std::optional<float> contrast;
   std::optional<int64_t> seed;  // >= 0 (CLI11 would wrap -3 into a huge unsigned)
   std::optional<std::string> resolution;  // "WxH"

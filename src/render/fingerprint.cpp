@@ -101,7 +101,7 @@ std::map<std::string, std::string> renderSettings(const RenderOptions& o, int wi
   if (o.passExtraSamples > 0 && o.passSampleCap > 1)
     s["extra_samples"] = floatText(o.passExtraSamples) + " (cap " + std::to_string(o.passSampleCap) + ")";
   if (o.directOnly) s["direct_only"] = "yes";  // likewise: only when on
-  if (o.gatherGuide > 0) s["gather_guide"] = floatText(o.gatherGuide);  // likewise: states made before it resume
+  if (!o.gatherGuide) s["gather_guide"] = "off";  // likewise (only when off, its default since 2026-12): states made before it resume
   return s;
 }
 

@@ -2,6 +2,7 @@
 #include "render/photon_integrator.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -16,14 +17,21 @@ namespace {
 constexpr int kGatherSpecularBounces = 4;  // a gather ray may pass this many mirrors/glass/sharp metals
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kSplitGlassVertices = 2;  // traceFrom
-// The gather guide's cones: the GuideCones::kMaxCones (32) global photons
-// nearest the gather point, one cone each around its incoming direction, of
-// half-angle 0.2 rad (11.5 degrees: wider than the photons' 1.2-degree
-// encoding error and than the spread of directions toward a bright patch a
-// few metres away across one estimate's disc). Measured on
-// scenes/sparse-room.json (docs/photon-map.md): 16 photons / 0.15 rad left
-// 2x the salt of 32 / 0.2; 0.08 rad 4x; 0.3 rad more relMSE.
-constexpr float kGatherConeOneMinusCos = 0.019933f;  // 1 - cos(0.2)
+constexpr uint32_t kGuideSub = 1u << 16;  // finalGather: the guide samples' kGather sub-streams
+// The gather guide's cones: one per global photon of the GuideCones::kMaxCones
+// (32) nearest the gather point, around its incoming direction, as wide as
+// the angle to its second-nearest other photon (a density estimate over
+// directions whose kernels follow the photons: narrow toward a bright patch
+// whose photons bunch, wide where they spread over the hemisphere), held in
+// [0.2 rad, 1 rad]. 0.2 rad is wider than the photons' 1.2-degree encoding
+// error and than the spread of directions toward a bright patch a few metres
+// away across one estimate's disc (with fixed 0.2-rad cones: 0.08 rad left
+// 4x the salt on scenes/sparse-room.json). Measured (docs/photon-map.md):
+// widths to the 4th-nearest photon gave 1.5x the salt on sparse-room, fixed
+// 0.2-rad cones 20% more noise than these on the moving static-room.
+constexpr int kGuideNeighbours = 2;
+constexpr float kGuideMinOneMinusCos = 0.019933f;  // 1 - cos(0.2)
+constexpr float kGuideMaxOneMinusCos = 0.459698f;  // 1 - cos(1)
 // A guide photon whose direction meets an area light, or is within 0.05 rad
 // of a delta light's direction, most likely came straight from it: its cone
 // would find only the light, whose direct light the shadow rays already
@@ -148,32 +156,70 @@ void PhotonIntegrator::gatherCones(const Hit& hit, const ShadingContext& ctx, fl
   cones = GuideCones{};
   // A non-black background lights the scene without photons: the guide
   // would take rays from it (truck-laser's sky: relMSE x2), so none there.
-  if (!(s_.gatherGuide > 0.0f) || !global_ || global_->size() == 0 || !scene_.background.isBlack()) return;
+  if (!s_.gatherGuide || !global_ || global_->size() == 0 || !scene_.background.isBlack()) return;
   const photon::KdTree& tree = global_->spatialTree();
   float maxR2 = s_.estimate.maxRadius * s_.estimate.maxRadius;
   int found = tree.knn(hit.p, GuideCones::kMaxCones, maxR2, ts.guideQuery);
   const photon::PhotonStore& st = tree.store();
   const uint32_t* idx = ts.guideQuery.index();
-  const float solidAngle = 2.0f * kPi * kGatherConeOneMinusCos;
   const bool testLights = scene_.lights.size() <= kGuideLightTests;
-  for (int i = 0; i < found; ++i) {
+  for (int i = 0; i < found && cones.count < GuideCones::kMaxCones; ++i) {
     Vec3f w = st.direction(idx[i]);
     if (!(dot(w, ctx.frame.n) > 0.0f)) continue;
     if (testLights && towardLight(hit.p, w, time01)) continue;
-    cones.cone[size_t(cones.count++)] = {w, kGatherConeOneMinusCos, solidAngle};
-    cones.totalSolidAngle += solidAngle;
+    cones.cone[size_t(cones.count++)].axis = w;
   }
-  if (cones.count > 0) cones.fraction = s_.gatherGuide;
+  const int n = cones.count;
+  if (n == 0) return;
+  // Each cone's half-angle: the angle to its photon's kGuideNeighbours-th
+  // nearest other photon, held in [0.2, 1] rad (kGuideMin/MaxOneMinusCos).
+  // The top kGuideNeighbours cosines per photon, from each pair's one dot
+  // product.
+  std::array<std::array<float, kGuideNeighbours>, GuideCones::kMaxCones> near;
+  for (auto& r : near) r.fill(-1.0f);
+  auto offer = [&near](int i, float d) {
+    auto& r = near[size_t(i)];
+    if (!(d > r.back())) return;
+    size_t q = r.size() - 1;
+    for (; q > 0 && d > r[q - 1]; --q) r[q] = r[q - 1];
+    r[q] = d;
+  };
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j) {
+      float d = dot(cones.cone[size_t(i)].axis, cones.cone[size_t(j)].axis);
+      offer(i, d);
+      offer(j, d);
+    }
+  for (int i = 0; i < n; ++i) {
+    // Fewer than kGuideNeighbours others: the widest cone.
+    float cosK = near[size_t(i)].back();
+    float omc = std::clamp(1.0f - cosK, kGuideMinOneMinusCos, kGuideMaxOneMinusCos);
+    GuideCones::Cone& k = cones.cone[size_t(i)];
+    k.oneMinusCos = omc;
+    k.solidAngle = 2.0f * kPi * omc;
+    k.density = 1.0f / (float(n) * k.solidAngle);
+    cones.totalSolidAngle += k.solidAngle;
+  }
+  cones.perCone = true;
+  cones.multi = true;
+  cones.fraction = 1.0f;
 }
 
 template <class Stream>
 Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, float time01, bool touched,
                                   Stream& sampler, int vertex, ThreadState& ts, const GuideCones& cones) const {
   Rgb sum(0.0f);
-  for (int i = 0; i < s_.gatherRays; ++i) {
+  const int pairs = cones.multi ? 2 : 1;
+  for (int r = 0; r < s_.gatherRays * pairs; ++r) {
+    // Multi-sample: ray i's BSDF sample draws as without a guide, its guide
+    // sample from sub-stream kGuideSub + i.
+    const int i = r / pairs, which = r % pairs;
+    const uint32_t sub = which ? kGuideSub + uint32_t(i) : uint32_t(i);
     BsdfSample bs;
-    Vec3f u = sampler.get3D(dims::vertexGroup(vertex, dims::kGather, uint32_t(i)));
-    if (!guidedBsdfSample(ctx, cones, {u.x, u.y}, u.z, bs)) continue;
+    Vec3f u = sampler.get3D(dims::vertexGroup(vertex, dims::kGather, sub));
+    if (cones.multi ? !guidedPairSample(ctx, cones, which, {u.x, u.y}, u.z, bs)
+                    : !guidedBsdfSample(ctx, cones, {u.x, u.y}, u.z, bs))
+      continue;
     Rgb beta = bs.weight;
     Vec3f o = scene_.spawnOrigin(hit.p, hit.n, bs.wi), d = bs.wi;
     bool moved = touched;
@@ -211,7 +257,7 @@ Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, flo
         break;
       }
       BsdfSample sb;
-      Vec3f u2 = sampler.get3D(dims::vertexGroup(vertex + 1 + bounce, dims::kGather, uint32_t(i)));
+      Vec3f u2 = sampler.get3D(dims::vertexGroup(vertex + 1 + bounce, dims::kGather, sub));
       if (!bsdfSample(c, {u2.x, u2.y}, u2.z, Transport::Radiance, sb)) break;
       beta *= sb.weight;
       o = scene_.spawnOrigin(h.p, h.n, sb.wi);

@@ -31,10 +31,11 @@ struct PhotonIntegratorSettings {
   bool spaceTime4D = false;       // --search 4d
   estimate::Options estimate;     // k, ks, fraction, radii, kernels (method set per query)
   int gatherRays = 1;             // final-gather rays per eye sample
-  // Share of the gather rays drawn toward the incoming directions of the
-  // global photons nearest the gather point (Jensen 1995), mixed with BSDF
-  // sampling (render/guided_sampling.h); 0: BSDF sampling alone.
-  float gatherGuide = 0.0f;
+  // Each gather ray a pair: one BSDF sample and one toward the incoming
+  // directions of the global photons nearest the gather point (Jensen
+  // 1995), balance heuristic (render/guided_sampling.h); false: the BSDF
+  // sample alone.
+  bool gatherGuide = false;
   bool visualizeGlobal = false;   // gather point = global-map estimate alone (no direct, no gather)
   int maxDepth = 16;
   // Time-dependent two-pass caustic estimates seen from the camera: the
@@ -70,7 +71,7 @@ class PhotonIntegrator {
     std::unique_ptr<estimate::Gatherer> caustic, caustic3, global, global3;
     std::unique_ptr<estimate::FixedKernelGatherer> fixed;  // fixedKernels only
     EstimateCounts counts;
-    photon::KnnQuery guideQuery;  // the gather guide's photons (gatherGuide > 0)
+    photon::KnnQuery guideQuery;  // the gather guide's photons (gatherGuide)
   };
 
   // The maps by kind (PhotonMaps::view(), render/photon_map.h); null or

@@ -70,14 +70,14 @@ struct RenderOptions {
   // heavy-tailed (docs/photon-map.md, "The estimate's variance").
   float kernelFootprint = 1.0f;
   int gatherRays = 1;
-  // Fixed-budget photon methods: share of the final-gather rays aimed along
-  // the incoming directions of the global photons nearest the gather point
-  // (Jensen 1995), mixed with BSDF sampling, so unbiased; 0: BSDF sampling
-  // alone. Off by default: it removes the salt of a large room lit by a
-  // small lamp, but doubles the relMSE of a small evenly lit room.
-  // Progressive passes do not use it. docs/photon-map.md, "The final gather
-  // where the global map is sparse".
-  float gatherGuide = 0.0f;
+  // The final gather's guide (Jensen 1995): each gather ray is a pair, one
+  // BSDF-sampled and one drawn toward the incoming directions of the global
+  // photons nearest the gather point, weighed by the balance heuristic
+  // (unbiased). It removes the salt of a large room lit by a small lamp and
+  // lowers the noise of an evenly lit small room. Progressive passes do not
+  // use it. docs/photon-map.md, "The final gather where the global map is
+  // sparse".
+  bool gatherGuide = true;
   bool visualizeGlobal = false;
   // How the user set the two photon counts, for the memory-budget error:
   // the flag, or the scene key and file (cli/render_command.cpp sets these).

@@ -108,7 +108,6 @@ constexpr FloatRange kKernelFootprint{0.0f, 1000.0f};  // --kernel-footprint
 constexpr FloatRange kAlpha{1e-3f, 0.999f};           // --alpha (progressive kernel shrink)
 constexpr FloatRange kTimeLimit{1e-12f, 1e9f};        // --time-limit, render.time_limit (seconds)
 constexpr FloatRange kCausticGuiding{0.0f, 0.95f};    // --caustic-guiding (the BSDF keeps at least 5%)
-constexpr FloatRange kGatherGuide{0.0f, 0.95f};       // --gather-guide (likewise)
 
 // ---- the 4D metric d^2 = |dx|^2 + kappa dt^2
 // The 4D kd-tree keys time as sqrt(kappa) t in float and resolves it to one
