@@ -15,6 +15,7 @@
 #include "error_capture.h"
 #include "media/medium.h"
 #include "media/phase.h"
+#include "render/fingerprint.h"
 #include "render/path_tracer.h"
 #include "render_fixtures.h"
 #include "scene/parse.h"
@@ -543,4 +544,19 @@ TEST_CASE("media: bad media input on the command line: located error, nothing wr
   check(sceneWith(R"("fog": {"type": "homogeneous", "sigma_a": 1, "sigma_s": 1, "g": 2})"), "", "media.fog.g:");
   check(sceneWith(kFog, "[]", R"("exterior_medium": "fog")"), "-m time --resolution 4x4",
         "need -m pathtrace");
+}
+
+TEST_CASE("media: the scene digest covers the media and where they are") {
+  auto d = airlightScene(1, 0.1f, 0.1f, 1, 1, 3);
+  std::string base = sceneDigest(d);
+  auto changed = d;
+  changed.media[0].sigmaS = Rgb(0.2f);
+  CHECK(sceneDigest(changed) != base);
+  changed = d;
+  changed.camera.medium = -1;
+  CHECK(sceneDigest(changed) != base);
+  changed = d;
+  changed.media[0].g = 0.5f;
+  CHECK(sceneDigest(changed) != base);
+  CHECK(sceneDigest(d) == base);
 }
