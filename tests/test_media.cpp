@@ -560,3 +560,57 @@ TEST_CASE("media: the scene digest covers the media and where they are") {
   CHECK(sceneDigest(changed) != base);
   CHECK(sceneDigest(d) == base);
 }
+
+TEST_CASE("media: a ray through an absorbing ball behind an interface keeps exp(-sigma_a 2R) of the sky") {
+  auto d = test::emptyScene(1, 1);
+  d.camera.position = {0, 0, 5};
+  d.camera.target = {0, 0, 0};
+  scene::MaterialDesc none;
+  none.type = scene::MaterialDesc::Type::Interface;
+  d.materials.push_back(none);
+  d.media.push_back(homogeneousDesc(Rgb(0.4f, 0.2f, 0.1f), Rgb(0.0f)));
+  auto ball = test::sphere(1.5f, {0, 0, 0}, 0);
+  ball.media.present = true;
+  ball.media.inside = 0;
+  d.objects.push_back(ball);
+  d.background = Rgb(1.0f);
+  auto scene = Scene::build(d);
+  REQUIRE(scene->hasMedia());
+  CHECK(scene->cameraMedium == -1);
+  PathTracer pt(*scene, 8);
+  Rng rng(31);
+  for (int c = 0; c < 3; ++c) {
+    double expected = std::exp(-(c == 0 ? 0.4 : c == 1 ? 0.2 : 0.1) * 3.0);
+    auto [mean, err] = meanAndError(20000, [&] {
+      Rgb L = pt.radiance({0, 0, 5}, {0, 0, -1}, 0.5f, rng);
+      return double(c == 0 ? L.r : c == 1 ? L.g : L.b);
+    });
+    CHECK(std::fabs(mean - expected) < 4 * err + 1e-6);
+    CHECK(err < 0.02);
+  }
+}
+
+TEST_CASE("media: a grid inside a moving object moves with it; media outside objects are static") {
+  auto d = test::emptyScene(1, 1);
+  d.materials.push_back(test::diffuse(Rgb(0.5f)));
+  d.media.push_back(rampDesc());
+  d.media.push_back(homogeneousDesc(Rgb(0.1f), Rgb(0.1f)));
+  auto a = test::box({1, 1, 1}, {0, 0, 0}, 0);
+  a.motion = test::translation({0, 0, 0}, {1, 0, 0});
+  a.media = {true, 0, 1};
+  auto b = test::box({1, 1, 1}, {3, 0, 0}, 0);
+  b.media = {true, 0, -1};
+  d.objects.push_back(a);
+  d.objects.push_back(b);
+  d.exteriorMedium = d.camera.medium = 1;
+  auto s = Scene::build(d);
+  // The grid twice (one instance per object it moves with), the fog once.
+  REQUIRE(s->media.size() == 3);
+  const media::Medium& inA = s->media[size_t(s->objects[0].mediumInterface.inside)];
+  const media::Medium& inB = s->media[size_t(s->objects[1].mediumInterface.inside)];
+  CHECK(inA.moving);
+  CHECK_FALSE(inB.moving);
+  CHECK(inA.density == inB.density);  // shared, not copied
+  CHECK(s->objects[0].mediumInterface.outside == s->cameraMedium);
+  CHECK(s->media[size_t(s->cameraMedium)].homogeneous());
+}
