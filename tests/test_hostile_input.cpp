@@ -113,7 +113,7 @@ TEST_CASE("hostile input: nesting deeper than the limit fails before nlohmann pa
 
   // Exactly the limit is parsed, and the located error is the real one.
   std::string ok = "{\"camera\": {}, \"objects\": [], \"x\": " + std::string(63, '[') + std::string(63, ']') + "}";
-  CHECK(errorOf(ok) == kFile + ":1: x: unknown key \"x\"; allowed keys: animation, background, camera, lights, materials, objects, render, textures");
+  CHECK(errorOf(ok) == kFile + ":1: x: unknown key \"x\"; allowed keys: animation, background, camera, exterior_medium, lights, materials, media, objects, render, textures");
 }
 
 TEST_CASE("hostile input: a 160k-key object and a long duplicate list are located correctly") {

@@ -342,11 +342,11 @@ TEST_CASE("scene parse: required keys, unknown keys, wrong types") {
   checkEdit([](Json& j) { j.erase("camera"); }, "top level", "missing required key \"camera\"");
   checkEdit([](Json& j) { j.erase("objects"); }, "top level", "missing required key \"objects\"");
   checkEdit([](Json& j) { j["objets"] = Json::array(); }, "objets",
-            "unknown key \"objets\" (did you mean \"objects\"?); allowed keys: animation, background, camera, lights, "
-            "materials, objects, render");
+            "unknown key \"objets\" (did you mean \"objects\"?); allowed keys: animation, background, camera, "
+            "exterior_medium, lights, materials, media, objects, render");
   checkEdit([](Json& j) { j["camera"]["positon"] = {0, 0, 0}; }, "camera.positon",
             "unknown key \"positon\" (did you mean \"position\"?); allowed keys: focal_distance, fov, lens_radius, "
-            "motion, position, resolution, shutter, target, up");
+            "medium, motion, position, resolution, shutter, target, up");
   checkEdit([](Json& j) { j["objects"][0]["shape"]["colour"] = 1; }, "objects[0].shape.colour",
             "unknown key \"colour\"; allowed keys: radius, reverse_orientation, type");
   checkEdit([](Json& j) { j["camera"] = "front"; }, "camera", "expected an object, got a string");
@@ -577,7 +577,7 @@ TEST_CASE("scene parse: lights") {
   checkEdit(light({{"type", "point"}, {"power", {10, -1, 10}}}), "lights[0].power",
             "must be non-negative in every channel, got [10, -1, 10]");
   checkEdit(light({{"type", "point"}, {"direction", {0, -1, 0}}}), "lights[0].direction",
-            "unknown key \"direction\"; allowed keys: motion, name, position, power, transform, type");
+            "unknown key \"direction\"; allowed keys: medium, motion, name, position, power, transform, type");
   checkEdit(light({{"type", "spot"}, {"target", {0, 0, 0}}, {"direction", {0, -1, 0}}}), "lights[0].direction",
             "give either \"target\" or \"direction\", not both");
   checkEdit(light({{"type", "spot"}, {"position", {1, 2, 3}}, {"target", {1, 2, 3}}}), "lights[0].target",

@@ -489,6 +489,7 @@ AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& a
   const RenderMethodTraits& method = renderMethodTraits(opt.method);
   if (!method.animation)
     throw Error("method '" + std::string(method.name) + "' cannot render an animation (use time, standard or pathtrace)");
+  checkMediaSupport(scene, opt);
   TDPM_ASSERT(ao.first >= 0 && ao.last < anim.frames && ao.first <= ao.last && ao.window >= 1, "bad frame range");
   if (opt.progressive) return renderProgressiveFrames(scene, anim, opt, ao, progress, sink);
   AnimationStats stats;

@@ -119,8 +119,43 @@ static void hashMeshBytes(Hasher& h, const std::string& label, scene::ShapeDesc&
   s.meshFile.clear();
 }
 
+// Participating media (issue 25) and where they are, by value and the
+// density by its bytes. Only for scenes that define media, so every other
+// scene's digest is what it was.
+static void hashMedia(Hasher& h, const scene::SceneDescription& d) {
+  if (d.media.empty()) return;
+  h.add(std::string("media"));
+  auto addInt = [&](int64_t v) { h.add(&v, sizeof v); };
+  auto addFloats = [&](const float* v, size_t n) { h.add(v, n * sizeof(float)); };
+  for (const scene::MediumDesc& m : d.media) {
+    h.add(m.name);
+    addInt(int64_t(m.type));
+    addFloats(&m.sigmaA.r, 3);
+    addFloats(&m.sigmaS.r, 3);
+    addFloats(&m.scale, 1);
+    addFloats(&m.g, 1);
+    if (m.type != scene::MediumDesc::Type::Grid) continue;
+    addInt(m.grid.nx), addInt(m.grid.ny), addInt(m.grid.nz);
+    addInt(int64_t(m.grid.density.size()));
+    addFloats(m.grid.density.data(), m.grid.density.size());
+    addFloats(&m.grid.bounds.lo.x, 3);
+    addFloats(&m.grid.bounds.hi.x, 3);
+    Affine3f p = m.placement.matrix();
+    addFloats(&p.m[0][0], 12);
+  }
+  addInt(d.exteriorMedium);
+  addInt(d.camera.medium);
+  for (const scene::LightDesc& l : d.lights) addInt(l.medium);
+  for (const scene::ObjectDesc& o : d.objects) {
+    addInt(o.media.present ? 1 : 0);
+    addInt(o.media.inside);
+    addInt(o.media.outside);
+  }
+}
+
 std::string sceneDigest(const scene::SceneDescription& d) {
   Hasher h;
+  hashMedia(h, d);
   scene::SceneDescription c = d;
   c.sourcePath.clear();
   c.render = scene::RenderSettings{};  // the options, merged with the flags, are hashed as settings

@@ -28,6 +28,7 @@ constexpr int kGuidedDiffuseVertices = 2;
 // instead of passing through a call per vertex.
 template <class Stream>
 Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState&) const {
+  if (scene_.hasMedia()) return traceMedia(origin, dir, time01, sampler);
   Rgb L(0.0f), beta(1.0f);
   // Product of eta^2 over the refractions so far: the radiance scaling
   // 1/eta^2 a refraction puts into beta is undone for Russian roulette,

@@ -47,6 +47,12 @@ class PathTracer {
   void flush(ThreadState&) const {}
 
  private:
+  // Scenes with participating media (render/volume_path.cpp): free flight,
+  // phase-function vertices, transmittance in next-event estimation and
+  // medium tracking through interfaces. trace() hands over at its start.
+  template <class Stream>
+  Rgb traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& sampler) const;
+
   const Scene& scene_;
   int maxDepth_;
   const CausticGuide* guide_;

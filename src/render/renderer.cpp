@@ -348,7 +348,9 @@ void addEstimateCounts(RenderStats& st, const EstimateCounts& c) {
 // pathtrace: the caustic guide, then the adaptive passes.
 void renderPathTraced(const Scene& scene, const RenderOptions& opt, const SamplingPlan& plan, const Progress& progress,
                       RenderStats& st, Film& film) {
-  CausticGuide guide = buildCausticGuide(scene, opt, progress, st);
+  // The guide's photons know no media: the volumetric path tracer
+  // (render/volume_path.cpp) samples plainly.
+  CausticGuide guide = scene.hasMedia() ? CausticGuide{} : buildCausticGuide(scene, opt, progress, st);
   PathTracer pt(scene, opt.maxDepth, &guide, opt.directOnly);
   renderPixels(scene, pt, plan, "render", progress, film);
   st.guideCellsFilled = guide.cacheFilled();
@@ -429,9 +431,20 @@ void gatherFilm(dist::Comm& comm, TileOwners& owners, RenderStats& st, Film& fil
 
 }  // namespace
 
+void checkMediaSupport(const Scene& scene, const RenderOptions& opt) {
+  if (!scene.hasMedia()) return;
+  if (opt.method != RenderMethod::PathTrace)
+    throw Error("the scene has participating media, which need -m pathtrace in this version (the volume photon map is "
+                "being built); method '" + std::string(renderMethodName(opt.method)) + "' would render it without them");
+  if (opt.progressive)
+    throw Error("the scene has participating media: progressive rendering does not support them in this version; "
+                "render with -m pathtrace without --progressive");
+}
+
 // One level: the memory check, the method's render, the gather.
 Film render(const Scene& scene, const RenderOptions& opt, const Progress& progress, RenderStats& st, dist::Comm& comm) {
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
+  checkMediaSupport(scene, opt);
   const RenderMethodTraits& method = renderMethodTraits(opt.method);
   if (opt.progressive) {  // render/progressive.h, from pass 0, on the same ranks
     ProgressiveState state;
@@ -471,6 +484,7 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
 Film renderFrame(const Scene& scene, const RenderOptions& opt, const FrameInput& frame, const Progress& progress,
                  RenderStats& st) {
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
+  checkMediaSupport(scene, opt);
   Timer timer;
   st = RenderStats{};
   Film film(scene.camera.width(), scene.camera.height());

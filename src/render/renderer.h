@@ -40,6 +40,13 @@ inline constexpr uint64_t kSamplerBytesPerPixel = 61;
 // black background, lights of zero power (every render path reports them).
 std::vector<std::string> sceneWarnings(const Scene& scene);
 
+// Throws tdpm::Error when the scene has participating media and the
+// options ask for anything but (non-progressive) `pathtrace`: the volume
+// photon maps are not built in this version, and rendering the scene
+// without its media would silently show something else. render(),
+// renderFrame() and renderAnimation() call it first.
+void checkMediaSupport(const Scene& scene, const RenderOptions& options);
+
 
 // Throws tdpm::Error, before any work, when the image and the photon maps
 // the options ask for cannot fit in the machine's available memory

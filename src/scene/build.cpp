@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "scene/bsdf_pbrt.h"
+#include "scene/build_media.h"
 #include "scene/limits.h"
 #include "scene/scene.h"
 #include "scene/subdivision.h"
@@ -390,9 +391,16 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
   for (size_t i = 0; i < s.materials.size(); ++i)
     if (s.materials[i].type == Material::Type::Mix) classifyMix(s.materials, desc.materials, i, mixState);
 
+  const bool media = scene::usesMedia(desc);
   for (const auto& od : desc.objects) {
+    // An "interface" surface is no surface: without media to bound it is
+    // not in the scene at all (pbrt's importer drops it the same way).
+    bool isInterface = desc.materials[od.material].type == scene::MaterialDesc::Type::Interface;
+    if (isInterface && (!media || !od.media.present)) continue;
     SceneObject o;
     o.name = od.name;
+    o.isInterface = isInterface;
+    o.mediumInterface = od.media;  // description indices until buildMedia
     o.material = od.material;
     o.reverseOrientation = od.shape.reverseOrientation;
     o.motion = makeMotion(od.placement, od.motion, s.shutter);
@@ -482,6 +490,7 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
   }
   s.embree_.commit();
   s.computeScale(desc.camera);
+  if (media) s.buildMedia(desc);
   return scene;
 }
 

@@ -24,6 +24,10 @@ constexpr uint64_t kMaxMeshFileBytes = uint64_t(1) << 30;  // 1 GiB
 // triangles): about what the largest mesh file holds, so that a small file
 // asking for many levels cannot ask for more memory than a large one.
 constexpr uint64_t kMaxSubdividedTriangles = uint64_t(1) << 24;
+// A medium's dense density grid (4 bytes per cell, inline or from a file)
+// larger than this is refused before it is allocated (also above half of
+// MemAvailable; scene/parse_media.cpp): 4 GiB is a 1024^3 grid.
+constexpr uint64_t kMaxDensityGridBytes = uint64_t(4) << 30;
 // Textures whose inputs are textures: how deep the chain may go (the
 // renderer evaluates it recursively, once per shaded hit).
 constexpr size_t kMaxTextureDepth = 64;

@@ -28,6 +28,7 @@
 #include "scene/mesh_obj.h"
 #include "scene/subdivision.h"
 #include "scene/parse_animation.h"
+#include "scene/parse_media.h"
 #include "scene/parse_node.h"
 #include "scene/render_method.h"
 
@@ -308,7 +309,8 @@ void readLens(const Node& n, CameraDesc* cam) {
 }
 
 CameraDesc readCamera(const Node& n, const std::optional<AnimationDesc>& animation) {
-  n.expectObject({"position", "target", "up", "fov", "resolution", "shutter", "motion", "lens_radius", "focal_distance"});
+  n.expectObject({"position", "target", "up", "fov", "resolution", "shutter", "motion", "lens_radius", "focal_distance",
+                  "medium"});
   CameraDesc cam;
   if (animation) {
     // The animation's timeline is the shutter every keyframe lives in.
@@ -646,6 +648,7 @@ const std::vector<MaterialKind>& materialKinds() {
       {"coatedconductor", T::CoatedConductor,
        {"type", "ior", "roughness", "roughness_remap", "eta", "k", "color", "conductor_roughness", "thickness"}},
       {"mix", T::Mix, {"type", "materials", "amount"}},
+      {"interface", T::Interface, {"type"}},  // no surface: a boundary between media (parse_media.h)
   };
   return kinds;
 }
@@ -728,6 +731,10 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader*
   return m;
 }
 
+// Objects may say "material": "interface" without defining it: pbrt's
+// no-surface material, only a boundary between media.
+constexpr const char* kInterfaceMaterial = "interface";
+
 std::vector<MaterialDesc> readMaterials(const Node& n, TextureReader* textures) {
   std::vector<MaterialDesc> out;
   std::vector<std::pair<size_t, std::vector<std::string>>> mixes;
@@ -736,6 +743,8 @@ std::vector<MaterialDesc> readMaterials(const Node& n, TextureReader* textures) 
     m.require(!name.empty(), "material names must not be empty");
     std::vector<std::string> mixNames;
     out.push_back(readMaterial(m, name, textures, &mixNames));
+    m.require(name != kInterfaceMaterial || out.back().type == MaterialDesc::Type::Interface,
+              "the material name \"interface\" is reserved for {\"type\": \"interface\"} (no surface)");
     nodes.push_back(m);
     if (!mixNames.empty()) mixes.push_back({out.size() - 1, mixNames});
   });
@@ -746,6 +755,7 @@ std::vector<MaterialDesc> readMaterials(const Node& n, TextureReader* textures) 
       auto it = std::find_if(out.begin(), out.end(), [&](const MaterialDesc& d) { return d.name == mixNames[c]; });
       Node e = nodes[i].member("materials").element(c);
       if (it == out.end()) e.fail("unknown material \"" + mixNames[c] + "\"");
+      e.require(it->type != MaterialDesc::Type::Interface, "a mix cannot contain an interface material (no surface)");
       out[i].mix[c] = uint32_t(it - out.begin());
     }
   }
@@ -779,6 +789,13 @@ uint32_t resolveMaterial(const Node& object, std::vector<MaterialDesc>* material
   }
   for (size_t i = 0; i < materials->size(); ++i)
     if ((*materials)[i].name == name) return uint32_t(i);
+  if (name == kInterfaceMaterial) {
+    MaterialDesc none;
+    none.type = MaterialDesc::Type::Interface;
+    none.name = kInterfaceMaterial;
+    materials->push_back(none);
+    return uint32_t(materials->size() - 1);
+  }
   if (!object.has("material")) {
     MaterialDesc grey;  // diffuse, reflectance 0.8
     grey.name = kDefaultMaterial;
@@ -947,7 +964,7 @@ std::string readName(const Node& n, const std::string& fallback) {
 }
 
 ObjectDesc readObject(const Node& n, std::vector<MaterialDesc>* materials, Shutter s, const std::string& sceneDir) {
-  n.expectObject({"name", "shape", "material", "transform", "motion"});
+  n.expectObject({"name", "shape", "material", "transform", "motion", "medium", "medium_interface"});
   ObjectDesc o;
   o.name = readName(n, n.path());
   o.shape = readShape(n.required("shape"), sceneDir);
@@ -1160,7 +1177,7 @@ LightDesc readLight(const Node& n, Shutter s, const std::string& sceneDir) {
                                         [&](const LightKind& k) { return typeName == k.name; });
   if (kind.type == LightDesc::Type::Directional && n.has("power"))
     n.member("power").fail("a directional light takes \"irradiance\" (W/m^2), not \"power\": a sun has no finite power");
-  std::vector<std::string> keys = {"type", "name", "transform", "motion"};
+  std::vector<std::string> keys = {"type", "name", "transform", "motion", "medium"};
   keys.insert(keys.end(), kind.keys.begin(), kind.keys.end());
   n.expectObject(keys);
 
@@ -1291,14 +1308,17 @@ RenderSettings readRender(const Node& n, float shutterLength) {
 // ---------------------------------------------------------------- scene
 
 SceneDescription readScene(const Node& root, const std::string& sourcePath) {
-  root.expectObject({"camera", "textures", "materials", "objects", "lights", "background", "render", "animation"});
+  root.expectObject({"camera", "textures", "materials", "objects", "lights", "background", "render", "animation", "media",
+                     "exterior_medium"});
   SceneDescription scene;
   scene.sourcePath = sourcePath;
   if (root.has("animation")) scene.animation = readAnimation(root.member("animation"));
+  std::string sceneDir = std::filesystem::path(sourcePath).parent_path().string();
+  detail::readMedia(root, sceneDir, &scene);
   scene.camera = readCamera(root.required("camera"), scene.animation);
+  scene.camera.medium = detail::readMediumKey(root.required("camera"), scene);
   Shutter shutter{scene.camera.shutterOpen, scene.camera.shutterClose,
                   scene.animation ? "the animation" : "the shutter"};
-  std::string sceneDir = std::filesystem::path(sourcePath).parent_path().string();
   std::optional<TextureReader> textures;
   if (root.has("textures")) {
     textures.emplace(root.member("textures"), sceneDir, &scene.textures);
@@ -1307,12 +1327,17 @@ SceneDescription readScene(const Node& root, const std::string& sourcePath) {
   if (root.has("materials")) scene.materials = readMaterials(root.member("materials"), textures ? &*textures : nullptr);
   Node objects = root.required("objects");
   size_t count = objects.arraySize("objects");
-  for (size_t i = 0; i < count; ++i)
+  for (size_t i = 0; i < count; ++i) {
     scene.objects.push_back(readObject(objects.element(i), &scene.materials, shutter, sceneDir));
+    detail::readObjectMedia(objects.element(i), scene, &scene.objects.back());
+  }
   if (root.has("lights")) {
     Node lights = root.member("lights");
     size_t n = lights.arraySize("lights");
-    for (size_t i = 0; i < n; ++i) scene.lights.push_back(readLight(lights.element(i), shutter, sceneDir));
+    for (size_t i = 0; i < n; ++i) {
+      scene.lights.push_back(readLight(lights.element(i), shutter, sceneDir));
+      scene.lights.back().medium = detail::readMediumKey(lights.element(i), scene);
+    }
   }
   if (root.has("background")) scene.background = root.member("background").color();
   if (root.has("render"))
@@ -1377,6 +1402,10 @@ Json parseJson(const std::string& text, const std::string& file) {
 }
 
 }  // namespace
+
+namespace detail {
+TransformDesc readPlacement(const Node& n) { return readTransform(n); }
+}  // namespace detail
 
 SceneDescription parseScene(const std::string& jsonText, const std::string& sourcePath) {
   Json doc = parseJson(jsonText, sourcePath);

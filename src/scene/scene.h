@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "math/bounds.h"
+#include "media/medium.h"
 #include "motion/motion.h"
 #include "scene/camera.h"
 #include "scene/description.h"
@@ -37,6 +38,16 @@ struct SceneObject {
   std::vector<Vec3f> worldNormals;  // triangles: world-space unit normals
   Vec3f worldCentre;                // sphere centre
   Affine3f inversePlacement;
+  // Media on its two sides (indices into Scene::media, -1 vacuum); when
+  // !present the object is no medium boundary (a ray keeps its medium).
+  scene::MediumInterfaceDesc mediumInterface;
+  bool isInterface = false;  // "interface" material: no surface, only the media boundary
+  // The medium a ray leaving the surface along w is in (pbrt's rule: the
+  // side w points into), or `current` when the object bounds no media.
+  int32_t mediumAfter(Vec3f n, Vec3f w, int32_t current) const {
+    if (!mediumInterface.present) return current;
+    return dot(w, n) > 0 ? mediumInterface.outside : mediumInterface.inside;
+  }
 };
 
 struct Hit {
@@ -100,6 +111,9 @@ class Scene {
   // Sets extent() and the epsilon's scale from the bounds (call after they
   // are final) and the camera's keyframes.
   void computeScale(const scene::CameraDesc& camera);
+  // Fills media, cameraMedium, lightMedia and each object's medium
+  // interface from the description (scene/build_media.cpp).
+  void buildMedia(const scene::SceneDescription& desc);
 
   Camera camera;
   Shutter shutter;
@@ -112,6 +126,14 @@ class Scene {
   Bounds3f bounds;                    // everything, over the whole shutter
   std::vector<Bounds3f> movingBounds; // swept bounds of each moving object / area light
   bool hasMotion = false;             // any moving object, light or camera
+  // Participating media (media/medium.h): one runtime medium per
+  // description medium that is used, and one more per object a grid moves
+  // with. Empty unless the scene has media: every integrator but the
+  // volumetric path tracer refuses such scenes (render/renderer.cpp).
+  std::vector<media::Medium> media;
+  int32_t cameraMedium = -1;          // index into media, -1 vacuum
+  std::vector<int32_t> lightMedia;    // per light: the medium it emits into
+  bool hasMedia() const { return !media.empty(); }
 
  private:
   const Material& shadeTextured(const Material& m, const Hit& hit, std::optional<Material>& scratch) const;

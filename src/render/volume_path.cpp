@@ -1,0 +1,236 @@
+// render/volume_path.cpp — volumetric path tracing (issue 25), the `pathtrace`
+// integrator of scenes with participating media (PathTracer::trace hands
+// over here when Scene::hasMedia()). As pbrt-v4's volpath:
+//   - a ray carries its medium (the camera's at the start); at a surface
+//     with a medium interface the next medium is the one on the side the
+//     new direction points into; "interface" surfaces are skipped (the ray
+//     goes on, changing medium only; no path vertex);
+//   - free flight (media/medium.h: closed form / delta tracking, spectral
+//     tracking weights for RGB) decides whether the segment to the next
+//     surface scatters, is absorbed or passes;
+//   - at a medium vertex: next-event estimation with the Henyey-Greenstein
+//     phase function, then a phase-sampled direction (weight 1);
+//   - at a surface vertex: next-event estimation with the BSDF and a BSDF
+//     sample, as render/path_tracer.cpp;
+//   - every shadow ray multiplies the transmittance of each medium it
+//     crosses (closed form / ratio tracking) through interface surfaces and
+//     stops at any other surface;
+//   - MIS (power heuristic) between light sampling and phase / BSDF
+//     sampling for area and environment lights, with directional densities
+//     only: both strategies see the same transmittance (in expectation), so
+//     weights that sum to one per direction keep the sum unbiased.
+// Differs from pbrt-v4: pbrt folds the free-flight and ratio-tracking
+// densities into its MIS weights (r_u, r_l) and uses the hero wavelength's
+// majorant; here spectral tracking keeps the weights per channel and MIS
+// directional (docs/media.md). No caustic guide (its photons know no media).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "media/medium.h"
+#include "media/phase.h"
+#include "render/direct_light.h"
+#include "render/path_tracer.h"
+#include "scene/bsdf.h"
+
+namespace tdpm {
+
+namespace {
+
+constexpr int kRouletteStartDepth = 3;  // as render/path_tracer.cpp
+// Interface surfaces one path or shadow ray may cross: a bound against
+// pathological geometry (a ray grazing along a mesh of interfaces), far
+// above what any scene needs (a ray crosses each closed interface twice).
+constexpr int kMaxCrossings = 4096;
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// The medium tracking's own random numbers (distances, event choices,
+// ratio tracking): a PCG stream seeded from one 2D draw of the sample's
+// stream, so that a sample stays a function of (seed, pixel, index).
+// The group (vertex 0's reserved light-choice slot, sub 1) is one no
+// other consumer draws.
+template <class Stream>
+Rng mediumRng(Stream& sampler) {
+  Vec2f s = sampler.get2D(dims::vertexGroup(0, dims::kLightChoice, 1));
+  uint64_t seed = (uint64_t(s.x * 16777216.0f) << 24) | uint64_t(s.y * 16777216.0f);
+  return Rng(seed, 0x6d65646961ull);  // "media"
+}
+
+// Transmittance from o along unit d over [0, tMax] starting in `medium`:
+// the product over the media crossed, through interface surfaces; zero at
+// any other surface (and at an emitter's).
+Rgb transmittanceTo(const Scene& s, Vec3f o, Vec3f d, float tMax, float time01, int32_t medium, Rng& rng) {
+  Rgb T(1.0f);
+  const Vec3f target = o + d * (std::isinf(tMax) ? 0.0f : tMax);
+  for (int crossing = 0; crossing < kMaxCrossings; ++crossing) {
+    Hit hit;
+    bool found = tMax > 0 && s.intersect(o, d, tMax, time01, hit);
+    if (medium >= 0) {
+      T = T * media::transmittance(s.media[size_t(medium)], o, d, found ? hit.t : std::max(tMax, 0.0f), time01, rng);
+      if (T.isBlack()) return T;
+    }
+    if (!found) return T;
+    if (hit.isLight() || !s.objects[hit.object].isInterface) return Rgb(0.0f);
+    medium = s.objects[hit.object].mediumAfter(hit.n, d, medium);
+    o = s.spawnOrigin(hit.p, hit.n, d);
+    if (!std::isinf(tMax)) tMax = dot(target - o, d);
+  }
+  return Rgb(0.0f);
+}
+
+// What scatters at a path vertex: a phase function (surface == null) or
+// a surface's BSDF. f includes the BSDF's |cos|.
+struct Scatterer {
+  const ShadingContext* surface = nullptr;
+  Vec3f wo;
+  float g = 0.0f;
+  Rgb f(Vec3f wi) const {
+    if (!surface) return Rgb(media::henyeyGreenstein(dot(wo, wi), g));
+    return bsdfEval(*surface, wi) * std::fabs(dot(wi, surface->frame.n));
+  }
+  float pdf(Vec3f wi) const { return surface ? bsdfPdf(*surface, wi) : media::henyeyGreenstein(dot(wo, wi), g); }
+};
+
+// Next-event estimation at point p (a medium point, or a surface hit with
+// its object), every light once, MIS against one phase / BSDF sample.
+template <class Stream>
+Rgb nextEvent(const Scene& s, Vec3f p, const Hit* hit, const Scatterer& sc, int32_t medium, float time01,
+              Stream& sampler, int vertex, Rng& rng) {
+  Rgb sum(0.0f);
+  for (size_t i = 0; i < s.lights.size(); ++i) {
+    const Light& light = s.lights[i];
+    if (bsdfAlone(light)) continue;  // phase / BSDF rays carry it at full weight
+    LightSample ls;
+    Vec2f u = sampler.get2D(dims::vertexGroup(vertex, dims::kLightPosition, uint32_t(i)));
+    if (!sampleLight(light, p, time01, u, ls)) continue;
+    Rgb f = sc.f(ls.wi);
+    if (f.isBlack()) continue;
+    Vec3f o = p;
+    int32_t m = medium;
+    if (hit) {
+      o = s.spawnOrigin(hit->p, hit->n, ls.wi);
+      m = s.objects[hit->object].mediumAfter(hit->n, ls.wi, medium);
+    }
+    float tMax = std::isinf(ls.distance) ? ls.distance : ls.distance * (1.0f - 1e-4f) - s.epsilon(p);
+    if (tMax <= 0) continue;
+    Rgb T = transmittanceTo(s, o, ls.wi, tMax, time01, m, rng);
+    if (T.isBlack()) continue;
+    if (light.isDelta()) {
+      sum += f * T * ls.li;
+    } else {
+      float w = 1.0f - emissionWeight(sc.pdf(ls.wi), ls.pdf, 1);
+      sum += f * T * ls.li * (w / ls.pdf);
+    }
+  }
+  return sum;
+}
+
+// Russian roulette as render/path_tracer.cpp: only below weight 1, from
+// kRouletteStartDepth. False: the path ends.
+template <class Stream>
+bool survives(Rgb& beta, float etaScale, int depth, Stream& sampler) {
+  float rr = beta.maxComponent() * etaScale;
+  if (depth + 1 < kRouletteStartDepth || rr >= 1.0f) return true;
+  if (sampler.get1D(dims::vertexGroup(depth, dims::kRoulette)) >= rr) return false;
+  beta = beta / rr;
+  return true;
+}
+
+}  // namespace
+
+// Longer than 80 lines on purpose, as PathTracer::trace: one sample's path,
+// its throughput, MIS state and medium kept local to the loop.
+template <class Stream>
+Rgb PathTracer::traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& sampler) const {
+  Rgb L(0.0f), beta(1.0f);
+  float etaScale = 1.0f;   // as trace(): refraction's 1/eta^2 undone for roulette
+  bool lastDelta = true;   // camera ray: full weight on emission
+  float lastPdf = 0.0f;
+  Vec3f lastP = origin;
+  int32_t medium = scene_.cameraMedium;
+  Rng rng = mediumRng(sampler);
+  int lastDepth = maxDepth_;
+  int depth = 0;
+  for (int crossings = 0; crossings < kMaxCrossings;) {
+    Hit hit;
+    bool found = scene_.intersect(origin, dir, kInf, time01, hit);
+    if (medium >= 0) {
+      const media::Medium& med = scene_.media[size_t(medium)];
+      media::FreeFlight ff = media::sampleFreeFlight(med, origin, dir, found ? hit.t : kInf, time01, rng, beta);
+      if (ff.event == media::FreeFlight::Event::Absorb || beta.isBlack() || !isFinite(beta)) break;
+      if (ff.event == media::FreeFlight::Event::Scatter) {
+        // ---- a medium vertex ----
+        if (depth == lastDepth) break;
+        Vec3f p = origin + dir * ff.t;
+        Scatterer sc{nullptr, -dir, med.g};
+        L += beta * nextEvent(scene_, p, nullptr, sc, medium, time01, sampler, depth, rng);
+        Vec2f u = sampler.get2D(dims::vertexGroup(depth, dims::kBsdf));
+        Vec3f wi;
+        lastPdf = media::sampleHenyeyGreenstein(-dir, med.g, u.x, u.y, wi);  // weight f / pdf = 1
+        lastDelta = false;
+        lastP = p;
+        origin = p;
+        dir = wi;
+        if (directOnly_) lastDepth = std::min(lastDepth, depth + 1);
+        if (!survives(beta, etaScale, depth, sampler)) break;
+        ++depth;
+        continue;
+      }
+    }
+    if (!found) {
+      L += beta * scene_.background;
+      if (!scene_.environmentLights.empty()) L += beta * environmentEmission(scene_, dir, lastPdf, 1, lastDelta);
+      break;
+    }
+    if (hit.isLight()) {  // ---- emission, attenuated by beta's media ----
+      const Light& light = scene_.lights[size_t(hit.light)];
+      AreaLightFrame f = areaLightFrame(light, time01);
+      Rgb le = areaLightRadiance(light, f, hit.n, -dir);
+      if (!le.isBlack()) {
+        float w = lastDelta ? 1.0f : emissionWeight(lastPdf, areaLightPdf(light, f, lastP, hit.p, hit.n), 1);
+        L += beta * le * w;
+      }
+      break;
+    }
+    const SceneObject& obj = scene_.objects[hit.object];
+    if (obj.isInterface) {  // no surface: only the medium changes
+      medium = obj.mediumAfter(hit.n, dir, medium);
+      origin = scene_.spawnOrigin(hit.p, hit.n, dir);
+      ++crossings;
+      continue;
+    }
+    // ---- a surface vertex ----
+    if (depth == lastDepth) break;
+    const Material& mat = resolveMaterial(scene_.materials.data(), obj.material, hit.p, -dir);
+    std::optional<Material> textured;
+    ShadingContext ctx = makeShadingContext(scene_.shadedMaterial(mat, hit, textured), scene_.albedoAt(mat, hit), hit.n, -dir);
+    if (directOnly_ && !mat.isDeltaOnly()) lastDepth = std::min(lastDepth, depth + 1);
+    if (!mat.isDeltaOnly()) {
+      Scatterer sc{&ctx, -dir, 0.0f};
+      L += beta * nextEvent(scene_, hit.p, &hit, sc, medium, time01, sampler, depth, rng);
+    }
+    BsdfSample bs;
+    Vec3f ub = sampler.get3D(dims::vertexGroup(depth, dims::kBsdf));
+    if (!bsdfSample(ctx, {ub.x, ub.y}, ub.z, Transport::Radiance, bs)) break;
+    beta *= bs.weight;
+    if (beta.isBlack() || !isFinite(beta)) break;
+    if (mat.transmits() && (dot(bs.wi, hit.n) < 0) != (dot(-dir, hit.n) < 0)) {
+      float eta = dot(-dir, hit.n) > 0 ? mat.ior : 1.0f / mat.ior;
+      etaScale *= eta * eta;
+    }
+    medium = obj.mediumAfter(hit.n, bs.wi, medium);
+    lastDelta = bs.delta;
+    lastPdf = bs.pdf;
+    lastP = hit.p;
+    origin = scene_.spawnOrigin(hit.p, hit.n, bs.wi);
+    dir = bs.wi;
+    if (!survives(beta, etaScale, depth, sampler)) break;
+    ++depth;
+  }
+  return L;
+}
+
+template Rgb PathTracer::traceMedia<RandomStream>(Vec3f, Vec3f, float, RandomStream&) const;
+template Rgb PathTracer::traceMedia<SobolStream>(Vec3f, Vec3f, float, SobolStream&) const;
+
+}  // namespace tdpm
