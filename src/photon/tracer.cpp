@@ -438,7 +438,7 @@ struct Tracer {
       ++rays;
       if (!scene.intersect(origin, dir, std::numeric_limits<float>::infinity(), time01, hit)) return rays;
       if (hit.isLight()) return rays;  // emitters absorb
-      const Material& mat = resolveMaterial(scene.materials.data(), scene.objects[hit.object].material, hit.p, -dir);
+      const Material& mat = scene.materialAt(hit, -dir);
       // A sharp metal continues a caustic path (after storing there: the
       // caustic seen on the metal itself is L S+ G).
       bool glossyBounce = settings.glossyCaustics && mat.isGlossy();

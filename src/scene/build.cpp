@@ -114,6 +114,9 @@ Material toMaterial(const scene::MaterialDesc& d) {
   m.specularTexture = d.specularTexture;  // node i of the TextureSet is desc.textures[i]
   m.roughnessTexture = d.roughnessTexture;
   m.baseRoughnessTexture = d.baseRoughnessTexture;
+  m.etaTexture = d.etaTexture;
+  m.kTexture = d.kTexture;
+  m.amountTexture = d.amountTexture;
   using R = scene::MaterialDesc::Remap;
   m.roughnessRemap = d.roughnessRemap == R::PbrtV3   ? RoughnessRemap::PbrtV3
                      : d.roughnessRemap == R::PbrtV4 ? RoughnessRemap::PbrtV4

@@ -371,6 +371,14 @@ TextureDesc readTexture(const Node& n) {
 // its inputs. Images are read once per (file, encoding).
 std::string resolveMeshPath(const std::string& file, const std::string& sceneDir);
 
+// Set while parseScene(text, path, meshes[, images]) runs (on this thread only).
+thread_local const MeshSource* tMeshSource = nullptr;
+thread_local const ImageSource* tImageSource = nullptr;
+// An image the caller of parseScene lends (ImageSource), or null.
+std::shared_ptr<const image::ImageRgb> lentImage(const std::string& file, const std::string& key) {
+  return tImageSource ? (*tImageSource)(file, key) : nullptr;
+}
+
 class TextureReader {
  public:
   TextureReader(const Node& block, const std::string& sceneDir, std::vector<TextureDef>* out)
@@ -478,6 +486,7 @@ void TextureReader::readImage(const Node& n, TextureDef* t) {
   }
   auto key = std::make_pair(t->file, image::encodingName(t->encoding));
   auto& img = images_[key];
+  if (!img) img = lentImage(key.first, key.second);
   if (!img) {
     try {
       img = std::make_shared<const image::ImageRgb>(image::readTextureImage(t->file, t->encoding));
@@ -519,7 +528,14 @@ TextureDef TextureReader::read(const Node& n, const std::string& name) {
     keys({"texture", "scale"}, false);
     t.kind = TextureDef::Kind::Scale;
     if (n.has("texture")) t.a = input(n.member("texture"), t.isFloat, "texture");
-    if (n.has("scale")) t.b = input(n.member("scale"), true, "scale");
+    if (n.has("scale")) {
+      // A number or float texture; on a spectrum texture also an [r, g, b]
+      // or a spectrum texture (pbrt-v3's tex1 x tex2, translucent's lobes).
+      Node sc = n.member("scale");
+      bool rgb = !t.isFloat && (sc.json().is_array() ||
+                                (sc.json().is_string() && !(*out_)[size_t(index(sc.string(), sc))].isFloat));
+      t.b = input(sc, !rgb, "scale");
+    }
   } else if (kind == "mix") {
     keys({"tex1", "tex2", "amount"}, false);
     t.kind = TextureDef::Kind::Mix;
@@ -584,9 +600,6 @@ float readRoughnessOrZero(const Node& n) {
   return r;
 }
 
-// A conductor's complex IOR: "eta" and "k", or a normal-incidence
-// reflectance "color", which becomes eta = 1, k = 2 sqrt(r) / sqrt(1 - r)
-// (pbrt-v4's conductor "reflectance": the Fresnel curve through r).
 // A material parameter naming a texture: its index, a located error when
 // it is unknown or of the other kind (float / spectrum).
 int32_t namedTextureIndex(const Node& c, TextureReader* textures, bool isFloat) {
@@ -599,13 +612,14 @@ int32_t namedTextureIndex(const Node& c, TextureReader* textures, bool isFloat) 
 }
 int32_t spectrumTextureIndex(const Node& c, TextureReader* textures) { return namedTextureIndex(c, textures, false); }
 
-// conductor: "color" may name a spectrum texture (a reflectance per hit).
+// A conductor's (coated conductor's) complex IOR: "eta" and "k", or a
+// normal-incidence reflectance "color", which becomes eta = 1, k = 2 sqrt(r)
+// / sqrt(1 - r) (pbrt-v4's conductor "reflectance": the Fresnel curve
+// through r). Each may name a spectrum texture (per hit, Scene::shadedMaterial).
 void readConductor(const Node& n, MaterialDesc* m, TextureReader* textures) {
   if (n.has("color") && (n.has("eta") || n.has("k")))
     n.member("color").fail("give either \"color\" (a reflectance) or \"eta\" and \"k\", not both");
   if (n.has("color") && n.member("color").json().is_string()) {
-    n.member("color").require(m->type == MaterialDesc::Type::Conductor,
-                              "a textured reflectance is supported on conductor only, not under a coating");
     m->eta = Rgb(1.0f);  // per hit from the texture (Scene::shadedMaterial)
     m->k = Rgb(0.0f);
     m->specularTexture = spectrumTextureIndex(n.member("color"), textures);
@@ -620,9 +634,17 @@ void readConductor(const Node& n, MaterialDesc* m, TextureReader* textures) {
     }
     return;
   }
-  m->eta = n.required("eta").color();
-  n.member("eta").require(m->eta.r > 0 && m->eta.g > 0 && m->eta.b > 0, "eta must be positive in every channel");
-  m->k = n.required("k").color();
+  // eta, k: each [r, g, b] or the name of a spectrum texture (per hit).
+  Node eta = n.required("eta");
+  if (eta.json().is_string()) {
+    m->etaTexture = spectrumTextureIndex(eta, textures);
+  } else {
+    m->eta = eta.color();
+    eta.require(m->eta.r > 0 && m->eta.g > 0 && m->eta.b > 0, "eta must be positive in every channel");
+  }
+  Node k = n.required("k");
+  if (k.json().is_string()) m->kTexture = spectrumTextureIndex(k, textures);
+  else m->k = k.color();
 }
 
 struct MaterialKind {
@@ -673,7 +695,9 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader*
       if (!e.json().is_string()) e.fail("expected a string (a material name), got " + detail::describeKind(e.json()));
       mixNames->push_back(e.string());
     }
-    if (n.has("amount")) {
+    if (n.has("amount") && n.member("amount").json().is_string()) {
+      m.amountTexture = namedTextureIndex(n.member("amount"), textures, true);  // per hit (Scene::materialAt)
+    } else if (n.has("amount")) {
       m.amount = n.member("amount").number();
       n.member("amount").require(m.amount >= 0 && m.amount <= 1, "amount must be in [0, 1], got " + fmt(m.amount));
     }
@@ -799,8 +823,6 @@ std::string resolveMeshPath(const std::string& file, const std::string& sceneDir
   return (std::filesystem::path(sceneDir) / p).lexically_normal().string();
 }
 
-// Set while parseScene(text, path, meshes) runs (on this thread only).
-thread_local const MeshSource* tMeshSource = nullptr;
 // "subdivision": {"scheme": "loop", "levels": N}: the topology and the
 // refined size are checked here, so that building cannot fail.
 void readSubdivision(const Node& n, ShapeDesc* shape) {
@@ -1033,7 +1055,9 @@ void readEnvironment(const Node& n, const std::string& sceneDir, LightDesc* l) {
   f.require(!file.empty(), "environment map file name must not be empty");
   l->mapFile = resolveMeshPath(file, sceneDir);
   std::string problem;
-  std::shared_ptr<const image::ImageRgb> map = loadEnvironmentMap(l->mapFile, l->equalArea, &problem);
+  std::shared_ptr<const image::ImageRgb> map =
+      lentImage(l->mapFile, l->equalArea ? "environment equal-area" : "environment latlong");
+  if (!map) map = loadEnvironmentMap(l->mapFile, l->equalArea, &problem);
   if (!map) f.fail(problem);
   l->map = std::move(map);
 }
@@ -1396,6 +1420,16 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
   } restore{tMeshSource};
   tMeshSource = &meshes;
   return parseScene(jsonText, sourcePath);
+}
+
+SceneDescription parseScene(const std::string& jsonText, const std::string& sourcePath, const MeshSource& meshes,
+                            const ImageSource& images) {
+  struct Restore {
+    const ImageSource* old;
+    ~Restore() { tImageSource = old; }
+  } restore{tImageSource};
+  tImageSource = &images;
+  return parseScene(jsonText, sourcePath, meshes);
 }
 
 SceneDescription loadScene(const std::string& path) {
