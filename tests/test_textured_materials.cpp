@@ -348,3 +348,35 @@ TEST_CASE("parseScene with an ImageSource: texture images and environment maps l
   // Without one, the same text reads the files: a located error for the missing one.
   CHECK(contains(test::errorMessageOf([&] { scene::parseScene(text, "dir/s.json"); }), "not-there.pfm"));
 }
+
+TEST_CASE("textured ior (rough dielectric, uber; pbrt-v3 glass and uber eta): each half as the constant ior; range checked") {
+  std::string dir = test::makeTempDir();
+  const std::string iors = R"(, "ior": {"type": "checkerboard", "float": true, "uscale": 2, "tex1": 1.2, "tex2": 2.0},
+    "low": {"type": "checkerboard", "float": true, "tex1": 0.9, "tex2": 1.5})";
+  auto material = [&](const std::string& m) {
+    return scene::parseScene(plane(std::string(kCheckers) + iors, R"("m": )" + m), dir + "/s.json");
+  };
+  scene::SceneDescription t = material(R"({"type": "dielectric", "roughness": 0.3, "ior": "ior"})");
+  auto s = Scene::build(t);
+  CHECK(shadedBelow(*s, -0.5f, 0.1f).ior == 1.2f);
+  CHECK(shadedBelow(*s, 0.5f, 0.1f).ior == 2.0f);
+  checkHalves(t, material(R"({"type": "dielectric", "roughness": 0.3, "ior": 1.2})"),
+              material(R"({"type": "dielectric", "roughness": 0.3, "ior": 2.0})"));
+  checkHalves(material(R"({"type": "uber", "specular": [0.8, 0.8, 0.8], "roughness": 0.1, "ior": "ior"})"),
+              material(R"({"type": "uber", "specular": [0.8, 0.8, 0.8], "roughness": 0.1, "ior": 1.2})"),
+              material(R"({"type": "uber", "specular": [0.8, 0.8, 0.8], "roughness": 0.1, "ior": 2.0})"));
+  // Values below 1: refused when built; a textured ior elsewhere: refused when read.
+  scene::SceneDescription low = material(R"({"type": "dielectric", "ior": "low"})");
+  CHECK(contains(test::errorMessageOf([&] { Scene::build(low); }), "material \"m\": its ior texture's values [0.9"));
+  CHECK(contains(test::errorMessageOf([&] { material(R"({"type": "plastic", "ior": "ior"})"); }),
+                 "materials.m.ior: a textured ior is supported on dielectric and uber only"));
+  // pbrt-v3: glass eta and uber index as FloatTextures.
+  const std::string tex = "Texture \"i\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float tex1\" 1.2 \"float tex2\" 2\n";
+  checkPbrtHalves(tex + R"(Material "glass" "texture eta" "i" "float roughness" 0.1)",
+                  R"(Material "glass" "float eta" 1.2 "float roughness" 0.1)", R"(Material "glass" "float eta" 2 "float roughness" 0.1)");
+  checkPbrtHalves(tex + R"(Material "uber" "texture index" "i")", R"(Material "uber" "float index" 1.2)",
+                  R"(Material "uber" "float index" 2)");
+  test::writeFile(dir + "/g.pbrt", pbrtPlane(tex + R"(Material "glass" "texture eta" "i" "float roughness" 0.1)"));
+  CHECK(contains(checkConvert(pbrt::importPbrtFile(dir + "/g.pbrt").scene, dir + "/g.json"), "\"ior\": \"i\""));
+  std::filesystem::remove_all(dir);
+}

@@ -315,6 +315,14 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     if (!(eta->r > 0 && eta->g > 0 && eta->b > 0)) failAt(at, label + ": " + pre + "eta must be positive");
     if (k->r < 0 || k->g < 0 || k->b < 0) failAt(at, label + ": " + pre + "k must not be negative");
   };
+  // pbrt-v3's glass and uber: eta (or index) is a FloatTexture; a varying
+  // one per hit (m.iorTexture; build.cpp refuses values below 1).
+  auto v3Eta = [&]() -> double {
+    const std::string key = ps.has("eta") ? "eta" : "index";
+    m.iorTexture = varyingTexture(ps, key, true, "an index of refraction");
+    if (m.iorTexture >= 0) return 1.5;  // not used: the texture is, per hit
+    return floatParam(ps, "eta", ps.has("index") ? floatParam(ps, "index", 1.5) : 1.5);
+  };
   if (type == "" || type == "interface" || type == "none") {
     slot.interface = true;
   } else if (type == "matte" || type == "diffuse") {
@@ -328,7 +336,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     m.specular = textureParam(ps, "Kr", Rgb(0.9f), &m.specularTexture);
     checkReflectance(ps, "Kr", m.specular);
   } else if (type == "glass" || type == "dielectric") {
-    double eta = floatParam(ps, "eta", ps.has("index") ? floatParam(ps, "index", 1.5) : 1.5);
+    double eta = type == "glass" ? v3Eta() : floatParam(ps, "eta", ps.has("index") ? floatParam(ps, "index", 1.5) : 1.5);
     if (!(eta >= 1)) failAt(at, label + ": eta " + fmtNum(eta) + " below 1 is not supported");
     m.ior = float(eta);
     double alpha;
@@ -367,7 +375,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     m.roughness = float(std::max(alpha, 1e-3));
     m.ior = 1.5f;
     if (type == "uber") {
-      double eta = floatParam(ps, "eta", ps.has("index") ? floatParam(ps, "index", 1.5) : 1.5);
+      double eta = v3Eta();
       if (!(eta >= 1)) failAt(at, label + ": eta " + fmtNum(eta) + " below 1 is not supported");
       m.ior = float(eta);
       Rgb kr = color(ps, "Kr", Rgb(0.0f)), kt = color(ps, "Kt", Rgb(0.0f)), op = color(ps, "opacity", Rgb(1.0f));

@@ -159,6 +159,7 @@ struct MaterialDesc {
   // indices, as the constants) when >= 0; either may be textured alone.
   int32_t etaTexture = -1, kTexture = -1;
   int32_t amountTexture = -1;  // mix: a float texture for amount when >= 0
+  int32_t iorTexture = -1;     // dielectric (rough or not), uber: a float texture for ior when >= 0
   enum class Remap { None, PbrtV3, PbrtV4 };
   Remap roughnessRemap = Remap::None;
 };

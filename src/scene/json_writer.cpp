@@ -166,10 +166,11 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
   using R = scene::MaterialDesc::Remap;
   if ((m.roughnessTexture >= 0 || m.baseRoughnessTexture >= 0) && m.roughnessRemap != R::None)
     j["roughness_remap"] = m.roughnessRemap == R::PbrtV3 ? "pbrt-v3" : "pbrt-v4";
+  Json iorValue = m.iorTexture >= 0 ? Json(textures.at(size_t(m.iorTexture))) : Json(num(m.ior));
   auto rough = [&]() -> Json { return m.roughnessTexture < 0 ? Json(num(m.roughness)) : Json(textures.at(size_t(m.roughnessTexture))); };
   // A conductor's complex IOR: a textured reflectance (eta, k per hit), or
   // eta and k, each constant or a texture's name.
-  auto ior = [&]() {
+  auto complexIor = [&]() {
     if (m.specularTexture >= 0) {
       j["color"] = spec;
       return;
@@ -181,7 +182,7 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
     case T::Diffuse: j["type"] = "diffuse"; albedo(); break;
     case T::Interface: j["type"] = "interface"; break;
     case T::Mirror: j["type"] = "mirror"; j["color"] = spec; break;
-    case T::Dielectric: j["type"] = "dielectric"; j["ior"] = num(m.ior); j["tint"] = spec; break;
+    case T::Dielectric: j["type"] = "dielectric"; j["ior"] = iorValue; j["tint"] = spec; break;
     case T::Metal: j["type"] = "metal"; j["color"] = spec; j["roughness"] = rough(); break;
     case T::Plastic:
       j["type"] = "plastic";
@@ -191,12 +192,12 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
       break;
     case T::Conductor:
       j["type"] = "conductor";
-      ior();
+      complexIor();
       j["roughness"] = rough();
       break;
     case T::RoughDielectric:
       j["type"] = "dielectric";
-      j["ior"] = num(m.ior);
+      j["ior"] = iorValue;
       j["tint"] = spec;
       j["roughness"] = rough();
       break;
@@ -205,7 +206,7 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
       j["type"] = m.type == T::Uber ? "uber" : "substrate";
       albedo();
       j["specular"] = spec;
-      if (m.type == T::Uber) j["ior"] = num(m.ior);
+      if (m.type == T::Uber) j["ior"] = iorValue;
       j["roughness"] = rough();
       break;
     case T::CoatedDiffuse:
@@ -219,7 +220,7 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
       j["type"] = "coatedconductor";
       j["ior"] = num(m.ior);
       j["roughness"] = rough();
-      ior();
+      complexIor();
       j["conductor_roughness"] =
           m.baseRoughnessTexture < 0 ? Json(num(m.baseRoughness)) : Json(textures.at(size_t(m.baseRoughnessTexture)));
       j["thickness"] = num(m.thickness);

@@ -89,6 +89,10 @@ struct Material {
   // >= 0: a mix's amount is this float node at the hit (pbrt-v4's
   // FloatTexture), read by resolveMaterial through Scene::materialAt.
   int32_t amountTexture = -1;
+  // >= 0: a dielectric's (rough dielectric's, uber's) ior is this float
+  // node at the hit (pbrt-v3's glass and uber eta FloatTextures), kept >= 1;
+  // build.cpp refuses a texture whose range reaches below 1.
+  int32_t iorTexture = -1;
   RoughnessRemap roughnessRemap = RoughnessRemap::None;
 
   // Purely delta (mirror, glass, smooth conductor): no photon is stored

@@ -722,7 +722,14 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader*
   if (n.has("tint")) specular(n.member("tint"));
   if (n.has("specular")) specular(n.member("specular"));
   else if (kind.type == T::Uber || kind.type == T::Substrate) m.specular = Rgb(0.25f);  // pbrt-v3's Ks
-  if (n.has("ior")) m.ior = readIor(n.member("ior"));
+  if (n.has("ior") && n.member("ior").json().is_string()) {
+    // A float texture, per hit (pbrt-v3's glass and uber eta); build.cpp checks its range.
+    n.member("ior").require(kind.type == T::Dielectric || kind.type == T::Uber,
+                            "a textured ior is supported on dielectric and uber only");
+    m.iorTexture = namedTextureIndex(n.member("ior"), textures, true);
+  } else if (n.has("ior")) {
+    m.ior = readIor(n.member("ior"));
+  }
   if (kind.type == T::Dielectric && n.has("roughness")) {
     m.type = T::RoughDielectric;
     pbrtKind = true;

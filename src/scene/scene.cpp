@@ -155,6 +155,7 @@ const Material& Scene::shadeTextured(const Material& m, const Hit& hit, std::opt
     Rgb v = textures.eval(uint32_t(m.kTexture), tp);
     for (int i = 0; i < 3; ++i) scratch->k[i] = std::max(v[i], 0.0f) * rel;
   }
+  if (m.iorTexture >= 0) scratch->ior = std::max(textures.eval(uint32_t(m.iorTexture), tp).r, 1.0f);
   if (m.roughnessTexture >= 0) {
     float x = textures.eval(uint32_t(m.roughnessTexture), tp).r;
     scratch->alpha = std::clamp(roughnessToAlpha(x, m.roughnessRemap), 1e-3f, 1.0f);

@@ -72,12 +72,12 @@ class Scene {
   // The material the BSDF sees at the hit: m itself, or (textured
   // parameters) a copy in `scratch` with the values at the hit: the
   // specular colour clamped to [0, 1] (a conductor's reflectance becomes
-  // its eta, k), a textured eta / k (clamped to eta >= 1e-3, k >= 0), the roughness remapped and clamped to [1e-3, 1] (never a
+  // its eta, k), a textured eta / k (clamped to eta >= 1e-3, k >= 0), a textured ior (>= 1), the roughness remapped and clamped to [1e-3, 1] (never a
   // delta lobe on a material classified non-delta). An empty optional costs
   // an untextured hit nothing.
   const Material& shadedMaterial(const Material& m, const Hit& hit, std::optional<Material>& scratch) const {
     if (m.specularTexture < 0 && m.roughnessTexture < 0 && m.baseRoughnessTexture < 0 && m.etaTexture < 0 &&
-        m.kTexture < 0)
+        m.kTexture < 0 && m.iorTexture < 0)
       return m;
     return shadeTextured(m, hit, scratch);
   }
