@@ -128,13 +128,13 @@ namespace tdpm {
 const Material& Scene::shadeTextured(const Material& m, const Hit& hit, std::optional<Material>& scratch) const {
   TexturePoint tp{uvAt(hit), hit.localP};
   scratch.emplace(m);
+  // A coated conductor's eta and k are relative to its coating (build.cpp).
+  const float rel = m.type == Material::Type::CoatedConductor ? 1.0f / m.ior : 1.0f;
   if (m.specularTexture >= 0) {
     Rgb v = textures.eval(uint32_t(m.specularTexture), tp);
     Rgb r{std::clamp(v.r, 0.0f, 1.0f), std::clamp(v.g, 0.0f, 1.0f), std::clamp(v.b, 0.0f, 1.0f)};
     if (m.type == Material::Type::Conductor || m.type == Material::Type::CoatedConductor) {
-      // pbrt-v4's conductor reflectance, as the constant path (parse.cpp,
-      // pbrt_mapping.cpp); under a coating relative to its index (build.cpp).
-      float rel = m.type == Material::Type::CoatedConductor ? 1.0f / m.ior : 1.0f;
+      // pbrt-v4's conductor reflectance, as the constant path (parse.cpp, pbrt_mapping.cpp).
       scratch->eta = Rgb(rel);
       for (int i = 0; i < 3; ++i) {
         float ri = std::min(r[i], 0.9999f);
@@ -146,7 +146,6 @@ const Material& Scene::shadeTextured(const Material& m, const Hit& hit, std::opt
   }
   // pbrt-v4's conductor eta / k textures (unbounded spectra): eta kept
   // positive and k non-negative, which the Fresnel formula needs.
-  float rel = m.type == Material::Type::CoatedConductor ? 1.0f / m.ior : 1.0f;
   if (m.etaTexture >= 0) {
     Rgb v = textures.eval(uint32_t(m.etaTexture), tp);
     for (int i = 0; i < 3; ++i) scratch->eta[i] = std::max(v[i], 1e-3f) * rel;
