@@ -634,8 +634,6 @@ TEST_CASE("textured material parameters: bad input gets located errors") {
   CHECK(contains(json(R"({"type": "metal", "roughness": 0.3, "roughness_remap": "pbrt-v4"})"),
                  "materials.m.roughness_remap: roughness_remap applies only to a textured roughness"));
   CHECK(contains(json(R"({"type": "metal", "roughness": "f", "roughness_remap": "v5"})"), "materials.m.roughness_remap"));
-  CHECK(contains(json(R"({"type": "coatedconductor", "color": "c"})"),
-                 "materials.m.color: a textured reflectance is supported on conductor only"));
   // A texture whose values reach past alpha 1: refused when the scene is built.
   std::string big = sceneText(R"("textures": {"b": {"type": "checkerboard", "float": true, "tex1": 0.5, "tex2": 2}},
     "materials": {"m": {"type": "metal", "roughness": "b"}}, "objects": [{"shape": {"type": "quad", "size": [1, 1]}, "material": "m"}])");
@@ -651,11 +649,12 @@ TEST_CASE("textured material parameters: bad input gets located errors") {
                  "roughness needs a float one"));
   CHECK(contains(pbrtError(defs + "Material \"coatedconductor\" \"texture conductor.roughness\" \"s\"\n"),
                  "texture \"s\" is a spectrum texture, but a roughness needs a float one"));
-  CHECK(contains(pbrtError(defs + "Material \"coatedconductor\" \"texture reflectance\" \"s\"\n"),
-                 "a textured reflectance under a coating is not supported"));
   CHECK(contains(pbrtError(defs + "Material \"conductor\" \"texture uroughness\" \"f\" \"float vroughness\" 0.1\n"),
                  "anisotropic roughness"));
   CHECK(contains(pbrtError(defs + "Material \"uber\" \"texture Ks\" \"f\"\n"), "is a float texture, but a reflectance needs a spectrum one"));
-  CHECK(contains(pbrtError(defs + "Material \"conductor\" \"texture eta\" \"s\"\n"), "a texture that varies is supported only as"));
+  CHECK(contains(pbrtError(defs + "Material \"uber\" \"texture opacity\" \"s\"\n"),
+                 "a spectrum texture that varies is supported only on Kd of matte"));
+  CHECK(contains(pbrtError(defs + "Material \"coateddiffuse\" \"texture thickness\" \"f\"\n"),
+                 "a float texture that varies is supported only as a roughness or a mix's amount"));
   std::filesystem::remove_all(dir);
 }

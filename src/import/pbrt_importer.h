@@ -140,6 +140,15 @@ class Importer {
   // A reflectance that may be any spectrum texture: sets *index (a texture
   // that varies; the value returned is then a placeholder) or returns the value.
   Rgb textureParam(const ParamSet& ps, const std::string& name, Rgb fallback, int32_t* index) const;
+  // A texture that varies on parameter `name`, of the kind isFloat: its
+  // index (the parameter marked used); -1 when the parameter is absent, a
+  // value or a constant texture (read as values). `what` names the
+  // parameter's use in the error for a texture of the other kind.
+  // translucent's Kd or Ks (*value, or *texture when >= 0) times its
+  // reflect: the product of two constants, or else a new scale texture node
+  // named `name` (then *texture).
+  void translucentLobe(const std::string& name, Rgb* value, int32_t* texture, Rgb reflect, int32_t reflectTexture);
+  int32_t varyingTexture(const ParamSet& ps, const std::string& name, bool isFloat, const std::string& what) const;
   uint32_t materialIndex(int slot);
   std::string uniqueMaterialName(const std::string& base);
   Rgb color(const ParamSet& ps, const std::string& name, Rgb fallback) const;

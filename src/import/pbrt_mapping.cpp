@@ -43,9 +43,10 @@ Rgb Importer::color(const ParamSet& ps, const std::string& name, Rgb fallback) c
     auto it = textures_.find(p->strings[0]);
     if (it == textures_.end()) ps.fail(*p, "no texture named \"" + p->strings[0] + "\" has been defined");
     if (!it->second.constant)
-      ps.fail(*p, "a texture that varies is supported only as a reflectance (Kd of matte and plastic, reflectance of "
-                  "diffuse, coateddiffuse and conductor, Kr of mirror, Kr = Kt of glass, Ks of uber and substrate); here only "
-                  "a constant texture is");
+      ps.fail(*p, "a spectrum texture that varies is supported only on Kd of matte and plastic, reflectance of diffuse, "
+                  "coateddiffuse, conductor and coatedconductor, Kr of mirror, Kr = Kt of glass, Ks of uber and substrate, "
+                  "Kd, Ks and reflect of translucent, eta and k of metal, conductor and coatedconductor; here only a constant "
+                  "texture is");
     return it->second.value;
   }
   if (p->type == "spectrum" || p->type == "blackbody") return spectrumColor(ps, *p);
@@ -59,7 +60,7 @@ double Importer::floatParam(const ParamSet& ps, const std::string& name, double 
     p->used = true;
     auto it = p->strings.size() == 1 ? textures_.find(p->strings[0]) : textures_.end();
     if (it == textures_.end() || !it->second.isFloat) ps.fail(*p, "expected a float texture");
-    if (!it->second.constant) ps.fail(*p, "a float texture that varies is supported only as a roughness; here only a constant one is");
+    if (!it->second.constant) ps.fail(*p, "a float texture that varies is supported only as a roughness or a mix's amount; here only a constant one is");
     return it->second.value.r;
   }
   if (p->type == "spectrum") return spectrumFloat(ps, *p);  // v4: a spectral eta (a constant, a named glass, ...)
@@ -192,18 +193,38 @@ void Importer::texture(const std::string& name, const std::string& kind, const s
   textures_[name] = v;
 }
 
-Rgb Importer::textureParam(const ParamSet& ps, const std::string& name, Rgb fallback, int32_t* index) const {
+int32_t Importer::varyingTexture(const ParamSet& ps, const std::string& name, bool isFloat, const std::string& what) const {
   const Param* p = ps.find(name);
-  if (p && p->type == "texture" && p->strings.size() == 1) {
-    auto it = textures_.find(p->strings[0]);
-    if (it != textures_.end() && !it->second.constant) {
-      p->used = true;
-      if (it->second.isFloat) ps.fail(*p, "texture \"" + p->strings[0] + "\" is a float texture, but a reflectance needs a spectrum one");
-      *index = it->second.index;
-      return Rgb(0.5f);  // not used: the texture is (clamped to [0, 1] when evaluated)
-    }
+  if (!p || p->type != "texture" || p->strings.size() != 1) return -1;
+  auto it = textures_.find(p->strings[0]);
+  if (it == textures_.end() || it->second.constant) return -1;
+  p->used = true;
+  if (it->second.isFloat != isFloat)
+    ps.fail(*p, "texture \"" + p->strings[0] + "\" is a " + (it->second.isFloat ? "float" : "spectrum") + " texture, but " +
+                    what + " needs a " + (isFloat ? "float" : "spectrum") + " one");
+  return it->second.index;
+}
+
+Rgb Importer::textureParam(const ParamSet& ps, const std::string& name, Rgb fallback, int32_t* index) const {
+  if (int32_t t = varyingTexture(ps, name, false, "a reflectance"); t >= 0) {
+    *index = t;
+    return Rgb(0.5f);  // not used: the texture is (clamped to [0, 1] when evaluated)
   }
   return color(ps, name, fallback);
+}
+
+void Importer::translucentLobe(const std::string& name, Rgb* value, int32_t* texture, Rgb reflect, int32_t reflectTexture) {
+  if (*texture < 0 && reflectTexture < 0) {
+    *value = *value * reflect;
+    return;
+  }
+  scene::TextureDef t;
+  t.name = name + " x reflect";
+  t.kind = scene::TextureDef::Kind::Scale;  // a x b per hit, in the constant path's order
+  t.a = {*texture, *value};
+  t.b = {reflectTexture, reflect};
+  result.scene.textures.push_back(std::move(t));
+  *texture = int32_t(result.scene.textures.size() - 1);
 }
 
 static void checkReflectance(const ParamSet& ps, const std::string& name, Rgb c) {
@@ -267,8 +288,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
       int32_t tex = -1;
       Rgb r = textureParam(ps, "reflectance", Rgb(1.0f), &tex);
       if (tex >= 0) {
-        if (!pre.empty()) failAt(at, label + ": a textured reflectance under a coating is not supported (only a constant one)");
-        m.specularTexture = tex;  // eta = 1, k from r per hit (Scene::shadedMaterial)
+        m.specularTexture = tex;  // eta = 1, k from r per hit (Scene::shadedMaterial; / ior under a coating)
         *eta = Rgb(1.0f);
         *k = Rgb(0.0f);
         return;
@@ -286,10 +306,22 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     bool filmV3 = v3 || (film_.given && film_.type == "image");
     Rgb cuEta = filmV3 ? Rgb(0.200964f, 0.923779f, 1.102306f) : Rgb(0.105133f, 0.977933f, 1.204671f);
     Rgb cuK = filmV3 ? Rgb(3.912923f, 2.453080f, 2.142269f) : Rgb(3.273486f, 2.592516f, 2.369186f);
-    *eta = color(ps, pre + "eta", cuEta);
-    *k = color(ps, pre + "k", cuK);
+    // Either may be a spectrum texture (pbrt-v3's and v4's conductors take
+    // textures there): per hit, eta kept >= 1e-3 and k >= 0 (Scene::shadedMaterial).
+    m.etaTexture = varyingTexture(ps, pre + "eta", false, "a conductor's eta");
+    m.kTexture = varyingTexture(ps, pre + "k", false, "a conductor's k");
+    *eta = m.etaTexture >= 0 ? Rgb(1.0f) : color(ps, pre + "eta", cuEta);
+    *k = m.kTexture >= 0 ? Rgb(0.0f) : color(ps, pre + "k", cuK);
     if (!(eta->r > 0 && eta->g > 0 && eta->b > 0)) failAt(at, label + ": " + pre + "eta must be positive");
     if (k->r < 0 || k->g < 0 || k->b < 0) failAt(at, label + ": " + pre + "k must not be negative");
+  };
+  // pbrt-v3's glass and uber: eta (or index) is a FloatTexture; a varying
+  // one per hit (m.iorTexture; build.cpp refuses values below 1).
+  auto v3Eta = [&]() -> double {
+    const std::string key = ps.has("eta") ? "eta" : "index";
+    m.iorTexture = varyingTexture(ps, key, true, "an index of refraction");
+    if (m.iorTexture >= 0) return 1.5;  // not used: the texture is, per hit
+    return floatParam(ps, "eta", ps.has("index") ? floatParam(ps, "index", 1.5) : 1.5);
   };
   if (type == "" || type == "interface" || type == "none") {
     slot.interface = true;
@@ -304,7 +336,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     m.specular = textureParam(ps, "Kr", Rgb(0.9f), &m.specularTexture);
     checkReflectance(ps, "Kr", m.specular);
   } else if (type == "glass" || type == "dielectric") {
-    double eta = floatParam(ps, "eta", ps.has("index") ? floatParam(ps, "index", 1.5) : 1.5);
+    double eta = type == "glass" ? v3Eta() : floatParam(ps, "eta", ps.has("index") ? floatParam(ps, "index", 1.5) : 1.5);
     if (!(eta >= 1)) failAt(at, label + ": eta " + fmtNum(eta) + " below 1 is not supported");
     m.ior = float(eta);
     double alpha;
@@ -343,7 +375,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     m.roughness = float(std::max(alpha, 1e-3));
     m.ior = 1.5f;
     if (type == "uber") {
-      double eta = floatParam(ps, "eta", ps.has("index") ? floatParam(ps, "index", 1.5) : 1.5);
+      double eta = v3Eta();
       if (!(eta >= 1)) failAt(at, label + ": eta " + fmtNum(eta) + " below 1 is not supported");
       m.ior = float(eta);
       Rgb kr = color(ps, "Kr", Rgb(0.0f)), kt = color(ps, "Kt", Rgb(0.0f)), op = color(ps, "opacity", Rgb(1.0f));
@@ -359,12 +391,11 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
         m.specular = kr;
       }
     } else if (type == "translucent") {
-      Rgb r = color(ps, "reflect", Rgb(0.5f)), t = color(ps, "transmit", Rgb(0.5f));
-      (void)t;
-      m.albedo.color = m.albedo.color * r;
-      m.specular = m.specular * r;
-      if (m.albedoTexture >= 0 || m.specularTexture >= 0)
-        failAt(at, label + ": a textured Kd or Ks on translucent is not supported");
+      int32_t rt = -1, tt = -1;
+      Rgb r = textureParam(ps, "reflect", Rgb(0.5f), &rt);
+      textureParam(ps, "transmit", Rgb(0.5f), &tt);  // dropped with the transmission (below)
+      translucentLobe(label + ".Kd", &m.albedo.color, &m.albedoTexture, r, rt);
+      translucentLobe(label + ".Ks", &m.specular, &m.specularTexture, r, rt);
       note(at, label + ": translucent approximated by its reflection lobes alone (Lambert reflect x Kd and GGX "
                        "reflect x Ks, as uber); its transmission is dropped (see docs/pbrt-import.md)");
     }
@@ -409,7 +440,10 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
       slot.mixSlots[i] = it->second;
     }
     m.type = T::Mix;
-    m.amount = float(floatParam(ps, "amount", 0.5));
+    // pbrt-v4's amount is a FloatTexture: per hit (Scene::materialAt); a
+    // value outside [0, 1] there picks one component, as in pbrt.
+    m.amountTexture = varyingTexture(ps, "amount", true, "a mix's amount");
+    if (m.amountTexture < 0) m.amount = float(floatParam(ps, "amount", 0.5));
     if (!(m.amount >= 0 && m.amount <= 1)) failAt(at, label + ": amount must be in [0, 1]");
   } else if (type == "measured") {
     failAt(at, label + ": measured BSDFs (tabulated \"filename\" data) are not supported: tdpm has no tabulated "

@@ -6,9 +6,12 @@
 // JSON key and the JSON side's own reason.
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <map>
 #include <string>
 
 #include "core/error.h"
+#include "image/texture_image.h"
 #include "import/pbrt_importer.h"
 #include "scene/json_writer.h"
 #include "scene/parse.h"
@@ -77,10 +80,22 @@ void Importer::validateAsJson() {
     idx->swap(s.indices);
     return true;
   };
+  // The images decoded already (texture files, environment maps), lent to
+  // the parser by absolute path and key: read once per import.
+  std::map<std::pair<std::string, std::string>, std::shared_ptr<const image::ImageRgb>> decoded;
+  auto absolute = [](const std::string& f) { return std::filesystem::absolute(f).lexically_normal().string(); };
+  for (const scene::TextureDef& t : sc.textures)
+    if (t.image) decoded[{absolute(t.file), image::encodingName(t.encoding)}] = t.image;
+  for (const scene::LightDesc& l : sc.lights)
+    if (l.map) decoded[{absolute(l.mapFile), l.equalArea ? "environment equal-area" : "environment latlong"}] = l.map;
+  scene::ImageSource images = [&](const std::string& file, const std::string& key) -> std::shared_ptr<const image::ImageRgb> {
+    auto it = decoded.find({absolute(file), key});
+    return it == decoded.end() ? nullptr : it->second;
+  };
   const std::string jsonName = "(imported scene)";
   scene::SceneDescription parsed;
   try {
-    parsed = scene::parseScene(js.json, jsonName, meshes);
+    parsed = scene::parseScene(js.json, jsonName, meshes, images);
   } catch (const Error& e) {
     // "(imported scene):LINE: objects[3].motion[1].scale: problem"
     std::string what = e.what();

@@ -446,7 +446,7 @@ struct Tracer {
         if (settings.invariant == InvariantPhotons::Only) return rays;  // nothing further is invariant
       }
       if (hit.isLight()) return rays;  // emitters absorb
-      const Material& mat = resolveMaterial(scene.materials.data(), scene.objects[hit.object].material, hit.p, -dir);
+      const Material& mat = scene.materialAt(hit, -dir);
       // A sharp metal continues a caustic path (after storing there: the
       // caustic seen on the metal itself is L S+ G).
       bool glossyBounce = settings.glossyCaustics && mat.isGlossy();

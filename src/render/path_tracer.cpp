@@ -72,7 +72,7 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
       break;  // emitters do not reflect
     }
     if (depth == lastDepth) break;
-    const Material& mat = resolveMaterial(scene_.materials.data(), scene_.objects[hit.object].material, hit.p, -dir);
+    const Material& mat = scene_.materialAt(hit, -dir);
     std::optional<Material> textured;
     ShadingContext ctx = makeShadingContext(scene_.shadedMaterial(mat, hit, textured), scene_.albedoAt(mat, hit), hit.n, -dir);
 

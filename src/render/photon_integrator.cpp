@@ -245,7 +245,7 @@ Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, flo
         }
         break;
       }
-      const Material& m = resolveMaterial(scene_.materials.data(), scene_.objects[h.object].material, h.p, -d);
+      const Material& m = scene_.materialAt(h, -d);
       std::optional<Material> textured;
       ShadingContext c = makeShadingContext(scene_.shadedMaterial(m, h, textured), scene_.albedoAt(m, h), h.n, -d);
       // Through mirrors, glass and sharp metals to the first diffuse-like
@@ -355,7 +355,7 @@ Rgb PhotonIntegrator::traceFrom(Vec3f origin, Vec3f dir, float time01, EyeVertex
       }
       break;
     }
-    const Material& mat = resolveMaterial(scene_.materials.data(), scene_.objects[hit.object].material, hit.p, -dir);
+    const Material& mat = scene_.materialAt(hit, -dir);
     std::optional<Material> textured;
     ShadingContext ctx = makeShadingContext(scene_.shadedMaterial(mat, hit, textured), scene_.albedoAt(mat, hit), hit.n, -dir);
     bool timeDependent = s_.timeDependent && touched;

@@ -115,6 +115,10 @@ Material toMaterial(const scene::MaterialDesc& d) {
   m.specularTexture = d.specularTexture;  // node i of the TextureSet is desc.textures[i]
   m.roughnessTexture = d.roughnessTexture;
   m.baseRoughnessTexture = d.baseRoughnessTexture;
+  m.etaTexture = d.etaTexture;
+  m.kTexture = d.kTexture;
+  m.amountTexture = d.amountTexture;
+  m.iorTexture = d.iorTexture;
   using R = scene::MaterialDesc::Remap;
   m.roughnessRemap = d.roughnessRemap == R::PbrtV3   ? RoughnessRemap::PbrtV3
                      : d.roughnessRemap == R::PbrtV4 ? RoughnessRemap::PbrtV4
@@ -183,6 +187,19 @@ void classifyTexturedRoughness(Material& m, const scene::MaterialDesc& d, const 
   }
   if (m.type == T::Dielectric) m.type = T::RoughDielectric;  // JSON: "dielectric" with a roughness texture
   m.alpha = std::max(aLo, kSmoothAlpha);
+}
+
+// A textured ior: every value the texture can give at least 1 (as a
+// constant ior must be; the dielectric BSDF assumes the outside is the
+// lower index).
+void checkTexturedIor(const scene::MaterialDesc& d, const TextureSet& textures) {
+  if (d.iorTexture >= int32_t(textures.nodes.size()))
+    throw Error("material \"" + d.name + "\": ior texture index out of range");
+  float lo, hi;
+  textures.range(uint32_t(d.iorTexture), &lo, &hi);
+  if (!(lo >= 1))
+    throw Error("material \"" + d.name + "\": its ior texture's values [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                "] reach below 1, which tdpm does not support (an ior must be at least 1)");
 }
 
 // A mix's components' classification (Material::causticTarget), through
@@ -386,6 +403,7 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
   for (const auto& m : desc.materials) {
     s.materials.push_back(toMaterial(m));
     if (m.roughnessTexture >= 0 || m.baseRoughnessTexture >= 0) classifyTexturedRoughness(s.materials.back(), m, s.textures);
+    if (m.iorTexture >= 0) checkTexturedIor(m, s.textures);
   }
   std::vector<uint8_t> mixState(s.materials.size(), 0);
   for (size_t i = 0; i < s.materials.size(); ++i)

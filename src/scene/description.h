@@ -147,7 +147,7 @@ struct MaterialDesc {
   // textures, a spectrum one) that replaces albedo when >= 0.
   int32_t albedoTexture = -1;
   // Mirror, metal, dielectric (and pbrt's glass): a spectrum texture for
-  // `specular` when >= 0; conductor: its reflectance (the "color" form);
+  // `specular` when >= 0; conductor, coated conductor: its reflectance (the "color" form);
   // uber, substrate: Ks.
   int32_t specularTexture = -1;
   // Every material with a roughness: a float texture (index into
@@ -155,6 +155,11 @@ struct MaterialDesc {
   // (pbrt's remaproughness: none, pbrt-v3's polynomial, pbrt-v4's sqrt).
   int32_t roughnessTexture = -1;
   int32_t baseRoughnessTexture = -1;  // coated conductor: a float texture for baseRoughness, same remap
+  // Conductor, coated conductor: spectrum textures for eta / k (absolute
+  // indices, as the constants) when >= 0; either may be textured alone.
+  int32_t etaTexture = -1, kTexture = -1;
+  int32_t amountTexture = -1;  // mix: a float texture for amount when >= 0
+  int32_t iorTexture = -1;     // dielectric (rough or not), uber: a float texture for ior when >= 0
   enum class Remap { None, PbrtV3, PbrtV4 };
   Remap roughnessRemap = Remap::None;
 };

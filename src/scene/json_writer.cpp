@@ -103,7 +103,8 @@ Json texInput(const scene::TexInput& in, bool isFloat, const std::vector<std::st
   return isFloat ? Json(num(in.value.r)) : rgb(in.value);
 }
 
-Json namedTexture(const scene::TextureDef& t, const std::vector<std::string>& names, const std::filesystem::path& jp) {
+Json namedTexture(const scene::TextureDef& t, const std::vector<scene::TextureDef>& defs,
+                  const std::vector<std::string>& names, const std::filesystem::path& jp) {
   using K = scene::TextureDef::Kind;
   Json j;
   auto uv = [&]() {
@@ -127,7 +128,10 @@ Json namedTexture(const scene::TextureDef& t, const std::vector<std::string>& na
     case K::Scale:
       j["type"] = "scale";
       j["texture"] = texInput(t.a, t.isFloat, names);
-      j["scale"] = texInput(t.b, true, names);
+      // A spectrum texture's scale may be RGB (pbrt-v3's tex1 x tex2): written as one then.
+      j["scale"] = texInput(t.b, t.isFloat || (t.b.texture >= 0 ? defs.at(size_t(t.b.texture)).isFloat
+                                                                 : t.b.value.r == t.b.value.g && t.b.value.g == t.b.value.b),
+                            names);
       break;
     case K::Mix:
       j["type"] = "mix";
@@ -162,12 +166,23 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
   using R = scene::MaterialDesc::Remap;
   if ((m.roughnessTexture >= 0 || m.baseRoughnessTexture >= 0) && m.roughnessRemap != R::None)
     j["roughness_remap"] = m.roughnessRemap == R::PbrtV3 ? "pbrt-v3" : "pbrt-v4";
+  Json iorValue = m.iorTexture >= 0 ? Json(textures.at(size_t(m.iorTexture))) : Json(num(m.ior));
   auto rough = [&]() -> Json { return m.roughnessTexture < 0 ? Json(num(m.roughness)) : Json(textures.at(size_t(m.roughnessTexture))); };
+  // A conductor's complex IOR: a textured reflectance (eta, k per hit), or
+  // eta and k, each constant or a texture's name.
+  auto complexIor = [&]() {
+    if (m.specularTexture >= 0) {
+      j["color"] = spec;
+      return;
+    }
+    j["eta"] = m.etaTexture >= 0 ? Json(textures.at(size_t(m.etaTexture))) : rgb(m.eta);
+    j["k"] = m.kTexture >= 0 ? Json(textures.at(size_t(m.kTexture))) : rgb(m.k);
+  };
   switch (m.type) {
     case T::Diffuse: j["type"] = "diffuse"; albedo(); break;
     case T::Interface: j["type"] = "interface"; break;
     case T::Mirror: j["type"] = "mirror"; j["color"] = spec; break;
-    case T::Dielectric: j["type"] = "dielectric"; j["ior"] = num(m.ior); j["tint"] = spec; break;
+    case T::Dielectric: j["type"] = "dielectric"; j["ior"] = iorValue; j["tint"] = spec; break;
     case T::Metal: j["type"] = "metal"; j["color"] = spec; j["roughness"] = rough(); break;
     case T::Plastic:
       j["type"] = "plastic";
@@ -177,17 +192,12 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
       break;
     case T::Conductor:
       j["type"] = "conductor";
-      if (m.specularTexture >= 0) {
-        j["color"] = spec;  // a textured reflectance (eta, k per hit)
-      } else {
-        j["eta"] = rgb(m.eta);
-        j["k"] = rgb(m.k);
-      }
+      complexIor();
       j["roughness"] = rough();
       break;
     case T::RoughDielectric:
       j["type"] = "dielectric";
-      j["ior"] = num(m.ior);
+      j["ior"] = iorValue;
       j["tint"] = spec;
       j["roughness"] = rough();
       break;
@@ -196,7 +206,7 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
       j["type"] = m.type == T::Uber ? "uber" : "substrate";
       albedo();
       j["specular"] = spec;
-      if (m.type == T::Uber) j["ior"] = num(m.ior);
+      if (m.type == T::Uber) j["ior"] = iorValue;
       j["roughness"] = rough();
       break;
     case T::CoatedDiffuse:
@@ -210,8 +220,7 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
       j["type"] = "coatedconductor";
       j["ior"] = num(m.ior);
       j["roughness"] = rough();
-      j["eta"] = rgb(m.eta);
-      j["k"] = rgb(m.k);
+      complexIor();
       j["conductor_roughness"] =
           m.baseRoughnessTexture < 0 ? Json(num(m.baseRoughness)) : Json(textures.at(size_t(m.baseRoughnessTexture)));
       j["thickness"] = num(m.thickness);
@@ -219,7 +228,7 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
     case T::Mix:
       j["type"] = "mix";
       j["materials"] = Json::array({materials.at(m.mix[0]).name, materials.at(m.mix[1]).name});
-      j["amount"] = num(m.amount);
+      j["amount"] = m.amountTexture >= 0 ? Json(textures.at(size_t(m.amountTexture))) : Json(num(m.amount));
       break;
   }
   return j;
@@ -332,7 +341,7 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
   std::vector<std::string> texNames = textureNames(sc.textures);
   if (!sc.textures.empty()) {
     Json textures = Json::object();
-    for (size_t i = 0; i < sc.textures.size(); ++i) textures[texNames[i]] = namedTexture(sc.textures[i], texNames, jp);
+    for (size_t i = 0; i < sc.textures.size(); ++i) textures[texNames[i]] = namedTexture(sc.textures[i], sc.textures, texNames, jp);
     root["textures"] = textures;
   }
   Json materials = Json::object();

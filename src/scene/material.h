@@ -82,6 +82,17 @@ struct Material {
   // fixed per material.
   int32_t roughnessTexture = -1;
   int32_t baseRoughnessTexture = -1;  // coated conductor: baseAlpha per hit, as roughnessTexture
+  // >= 0: a conductor's (coated conductor's) eta / k is this spectrum node
+  // at the hit (pbrt-v4's SpectrumTextures), eta clamped to >= 1e-3 and k
+  // to >= 0; under a coating divided by ior, as the constants are.
+  int32_t etaTexture = -1, kTexture = -1;
+  // >= 0: a mix's amount is this float node at the hit (pbrt-v4's
+  // FloatTexture), read by resolveMaterial through Scene::materialAt.
+  int32_t amountTexture = -1;
+  // >= 0: a dielectric's (rough dielectric's, uber's) ior is this float
+  // node at the hit (pbrt-v3's glass and uber eta FloatTextures), kept >= 1;
+  // build.cpp refuses a texture whose range reaches below 1.
+  int32_t iorTexture = -1;
   RoughnessRemap roughnessRemap = RoughnessRemap::None;
 
   // Purely delta (mirror, glass, smooth conductor): no photon is stored
@@ -114,11 +125,14 @@ struct Material {
 
 // The material a hit uses: a mix material picks one of its two per hit,
 // deterministically from the point and direction (as pbrt-v4's MixMaterial
-// hashes them), with probability mixAmount for the second; mixes of mixes
+// hashes them), with probability amount(mix) for the second; mixes of mixes
 // resolve in turn, each level with its own hash (a shared one would tie the
 // inner choice to the outer). Material indices stay out of the hash: a
 // scene and its `tdpm convert` JSON number materials differently.
-inline const Material& resolveMaterial(const Material* materials, uint32_t index, Vec3f p, Vec3f wo) {
+// amount(const Material&) -> float: the mix's amount at this hit (its
+// constant, or its texture there: Scene::materialAt); asked only of mixes.
+template <class Amount>
+inline const Material& resolveMaterial(const Material* materials, uint32_t index, Vec3f p, Vec3f wo, Amount amount) {
   const Material* m = materials + index;
   if (m->type != Material::Type::Mix) return *m;
   float v[6] = {p.x, p.y, p.z, wo.x, wo.y, wo.z};
@@ -137,9 +151,14 @@ inline const Material& resolveMaterial(const Material* materials, uint32_t index
     z ^= z >> 31;
     float u = float(z >> 40) * 0x1p-24f;  // [0, 1)
     // pbrt-v4: amount <= 0 is the first, >= 1 the second, else amount < u the first.
-    m = materials + (m->mixAmount < u || m->mixAmount <= 0.0f ? m->mixOf[0] : m->mixOf[1]);
+    float a = amount(*m);
+    m = materials + (a < u || a <= 0.0f ? m->mixOf[0] : m->mixOf[1]);
   }
   return *m;
+}
+// Constant amounts only (tests, and materials without an amount texture).
+inline const Material& resolveMaterial(const Material* materials, uint32_t index, Vec3f p, Vec3f wo) {
+  return resolveMaterial(materials, index, p, wo, [](const Material& m) { return m.mixAmount; });
 }
 
 }  // namespace tdpm

@@ -373,6 +373,14 @@ TextureDesc readTexture(const Node& n) {
 // its inputs. Images are read once per (file, encoding).
 std::string resolveMeshPath(const std::string& file, const std::string& sceneDir);
 
+// Set while parseScene(text, path, meshes[, images]) runs (on this thread only).
+thread_local const MeshSource* tMeshSource = nullptr;
+thread_local const ImageSource* tImageSource = nullptr;
+// An image the caller of parseScene lends (ImageSource), or null.
+std::shared_ptr<const image::ImageRgb> lentImage(const std::string& file, const std::string& key) {
+  return tImageSource ? (*tImageSource)(file, key) : nullptr;
+}
+
 class TextureReader {
  public:
   TextureReader(const Node& block, const std::string& sceneDir, std::vector<TextureDef>* out)
@@ -480,6 +488,7 @@ void TextureReader::readImage(const Node& n, TextureDef* t) {
   }
   auto key = std::make_pair(t->file, image::encodingName(t->encoding));
   auto& img = images_[key];
+  if (!img) img = lentImage(key.first, key.second);
   if (!img) {
     try {
       img = std::make_shared<const image::ImageRgb>(image::readTextureImage(t->file, t->encoding));
@@ -521,7 +530,14 @@ TextureDef TextureReader::read(const Node& n, const std::string& name) {
     keys({"texture", "scale"}, false);
     t.kind = TextureDef::Kind::Scale;
     if (n.has("texture")) t.a = input(n.member("texture"), t.isFloat, "texture");
-    if (n.has("scale")) t.b = input(n.member("scale"), true, "scale");
+    if (n.has("scale")) {
+      // A number or float texture; on a spectrum texture also an [r, g, b]
+      // or a spectrum texture (pbrt-v3's tex1 x tex2, translucent's lobes).
+      Node sc = n.member("scale");
+      bool rgb = !t.isFloat && (sc.json().is_array() ||
+                                (sc.json().is_string() && !(*out_)[size_t(index(sc.string(), sc))].isFloat));
+      t.b = input(sc, !rgb, "scale");
+    }
   } else if (kind == "mix") {
     keys({"tex1", "tex2", "amount"}, false);
     t.kind = TextureDef::Kind::Mix;
@@ -586,9 +602,6 @@ float readRoughnessOrZero(const Node& n) {
   return r;
 }
 
-// A conductor's complex IOR: "eta" and "k", or a normal-incidence
-// reflectance "color", which becomes eta = 1, k = 2 sqrt(r) / sqrt(1 - r)
-// (pbrt-v4's conductor "reflectance": the Fresnel curve through r).
 // A material parameter naming a texture: its index, a located error when
 // it is unknown or of the other kind (float / spectrum).
 int32_t namedTextureIndex(const Node& c, TextureReader* textures, bool isFloat) {
@@ -601,13 +614,14 @@ int32_t namedTextureIndex(const Node& c, TextureReader* textures, bool isFloat) 
 }
 int32_t spectrumTextureIndex(const Node& c, TextureReader* textures) { return namedTextureIndex(c, textures, false); }
 
-// conductor: "color" may name a spectrum texture (a reflectance per hit).
+// A conductor's (coated conductor's) complex IOR: "eta" and "k", or a
+// normal-incidence reflectance "color", which becomes eta = 1, k = 2 sqrt(r)
+// / sqrt(1 - r) (pbrt-v4's conductor "reflectance": the Fresnel curve
+// through r). Each may name a spectrum texture (per hit, Scene::shadedMaterial).
 void readConductor(const Node& n, MaterialDesc* m, TextureReader* textures) {
   if (n.has("color") && (n.has("eta") || n.has("k")))
     n.member("color").fail("give either \"color\" (a reflectance) or \"eta\" and \"k\", not both");
   if (n.has("color") && n.member("color").json().is_string()) {
-    n.member("color").require(m->type == MaterialDesc::Type::Conductor,
-                              "a textured reflectance is supported on conductor only, not under a coating");
     m->eta = Rgb(1.0f);  // per hit from the texture (Scene::shadedMaterial)
     m->k = Rgb(0.0f);
     m->specularTexture = spectrumTextureIndex(n.member("color"), textures);
@@ -622,9 +636,17 @@ void readConductor(const Node& n, MaterialDesc* m, TextureReader* textures) {
     }
     return;
   }
-  m->eta = n.required("eta").color();
-  n.member("eta").require(m->eta.r > 0 && m->eta.g > 0 && m->eta.b > 0, "eta must be positive in every channel");
-  m->k = n.required("k").color();
+  // eta, k: each [r, g, b] or the name of a spectrum texture (per hit).
+  Node eta = n.required("eta");
+  if (eta.json().is_string()) {
+    m->etaTexture = spectrumTextureIndex(eta, textures);
+  } else {
+    m->eta = eta.color();
+    eta.require(m->eta.r > 0 && m->eta.g > 0 && m->eta.b > 0, "eta must be positive in every channel");
+  }
+  Node k = n.required("k");
+  if (k.json().is_string()) m->kTexture = spectrumTextureIndex(k, textures);
+  else m->k = k.color();
 }
 
 struct MaterialKind {
@@ -676,7 +698,9 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader*
       if (!e.json().is_string()) e.fail("expected a string (a material name), got " + detail::describeKind(e.json()));
       mixNames->push_back(e.string());
     }
-    if (n.has("amount")) {
+    if (n.has("amount") && n.member("amount").json().is_string()) {
+      m.amountTexture = namedTextureIndex(n.member("amount"), textures, true);  // per hit (Scene::materialAt)
+    } else if (n.has("amount")) {
       m.amount = n.member("amount").number();
       n.member("amount").require(m.amount >= 0 && m.amount <= 1, "amount must be in [0, 1], got " + fmt(m.amount));
     }
@@ -701,7 +725,14 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader*
   if (n.has("tint")) specular(n.member("tint"));
   if (n.has("specular")) specular(n.member("specular"));
   else if (kind.type == T::Uber || kind.type == T::Substrate) m.specular = Rgb(0.25f);  // pbrt-v3's Ks
-  if (n.has("ior")) m.ior = readIor(n.member("ior"));
+  if (n.has("ior") && n.member("ior").json().is_string()) {
+    // A float texture, per hit (pbrt-v3's glass and uber eta); build.cpp checks its range.
+    n.member("ior").require(kind.type == T::Dielectric || kind.type == T::Uber,
+                            "a textured ior is supported on dielectric and uber only");
+    m.iorTexture = namedTextureIndex(n.member("ior"), textures, true);
+  } else if (n.has("ior")) {
+    m.ior = readIor(n.member("ior"));
+  }
   if (kind.type == T::Dielectric && n.has("roughness")) {
     m.type = T::RoughDielectric;
     pbrtKind = true;
@@ -816,8 +847,6 @@ std::string resolveMeshPath(const std::string& file, const std::string& sceneDir
   return (std::filesystem::path(sceneDir) / p).lexically_normal().string();
 }
 
-// Set while parseScene(text, path, meshes) runs (on this thread only).
-thread_local const MeshSource* tMeshSource = nullptr;
 // "subdivision": {"scheme": "loop", "levels": N}: the topology and the
 // refined size are checked here, so that building cannot fail.
 void readSubdivision(const Node& n, ShapeDesc* shape) {
@@ -1050,7 +1079,9 @@ void readEnvironment(const Node& n, const std::string& sceneDir, LightDesc* l) {
   f.require(!file.empty(), "environment map file name must not be empty");
   l->mapFile = resolveMeshPath(file, sceneDir);
   std::string problem;
-  std::shared_ptr<const image::ImageRgb> map = loadEnvironmentMap(l->mapFile, l->equalArea, &problem);
+  std::shared_ptr<const image::ImageRgb> map =
+      lentImage(l->mapFile, l->equalArea ? "environment equal-area" : "environment latlong");
+  if (!map) map = loadEnvironmentMap(l->mapFile, l->equalArea, &problem);
   if (!map) f.fail(problem);
   l->map = std::move(map);
 }
@@ -1425,6 +1456,16 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
   } restore{tMeshSource};
   tMeshSource = &meshes;
   return parseScene(jsonText, sourcePath);
+}
+
+SceneDescription parseScene(const std::string& jsonText, const std::string& sourcePath, const MeshSource& meshes,
+                            const ImageSource& images) {
+  struct Restore {
+    const ImageSource* old;
+    ~Restore() { tImageSource = old; }
+  } restore{tImageSource};
+  tImageSource = &images;
+  return parseScene(jsonText, sourcePath, meshes);
 }
 
 SceneDescription loadScene(const std::string& path) {

@@ -23,5 +23,13 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
 // JSON) instead of reading OBJ files; false means "no such mesh".
 using MeshSource = std::function<bool(const std::string& file, std::vector<Vec3f>* vertices, std::vector<uint32_t>* indices)>;
 SceneDescription parseScene(const std::string& jsonText, const std::string& sourcePath, const MeshSource& meshes);
+// ... and images too: texture files and environment maps come from
+// `images(file, key)` (file as resolved against sourcePath; key the
+// texture's image::encodingName, or "environment latlong" / "environment
+// equal-area") when it returns one, else from the file. The importer lends
+// what it has decoded already, so that validating reads no image twice.
+using ImageSource = std::function<std::shared_ptr<const image::ImageRgb>(const std::string& file, const std::string& key)>;
+SceneDescription parseScene(const std::string& jsonText, const std::string& sourcePath, const MeshSource& meshes,
+                            const ImageSource& images);
 
 }  // namespace tdpm::scene

@@ -128,20 +128,33 @@ namespace tdpm {
 const Material& Scene::shadeTextured(const Material& m, const Hit& hit, std::optional<Material>& scratch) const {
   TexturePoint tp{uvAt(hit), hit.localP};
   scratch.emplace(m);
+  // A coated conductor's eta and k are relative to its coating (build.cpp).
+  const float rel = m.type == Material::Type::CoatedConductor ? 1.0f / m.ior : 1.0f;
   if (m.specularTexture >= 0) {
     Rgb v = textures.eval(uint32_t(m.specularTexture), tp);
     Rgb r{std::clamp(v.r, 0.0f, 1.0f), std::clamp(v.g, 0.0f, 1.0f), std::clamp(v.b, 0.0f, 1.0f)};
-    if (m.type == Material::Type::Conductor) {
+    if (m.type == Material::Type::Conductor || m.type == Material::Type::CoatedConductor) {
       // pbrt-v4's conductor reflectance, as the constant path (parse.cpp, pbrt_mapping.cpp).
-      scratch->eta = Rgb(1.0f);
+      scratch->eta = Rgb(rel);
       for (int i = 0; i < 3; ++i) {
         float ri = std::min(r[i], 0.9999f);
-        scratch->k[i] = 2.0f * std::sqrt(ri) / std::sqrt(1.0f - ri);
+        scratch->k[i] = 2.0f * std::sqrt(ri) / std::sqrt(1.0f - ri) * rel;
       }
     } else {
       scratch->specular = r;
     }
   }
+  // pbrt-v4's conductor eta / k textures (unbounded spectra): eta kept
+  // positive and k non-negative, which the Fresnel formula needs.
+  if (m.etaTexture >= 0) {
+    Rgb v = textures.eval(uint32_t(m.etaTexture), tp);
+    for (int i = 0; i < 3; ++i) scratch->eta[i] = std::max(v[i], 1e-3f) * rel;
+  }
+  if (m.kTexture >= 0) {
+    Rgb v = textures.eval(uint32_t(m.kTexture), tp);
+    for (int i = 0; i < 3; ++i) scratch->k[i] = std::max(v[i], 0.0f) * rel;
+  }
+  if (m.iorTexture >= 0) scratch->ior = std::max(textures.eval(uint32_t(m.iorTexture), tp).r, 1.0f);
   if (m.roughnessTexture >= 0) {
     float x = textures.eval(uint32_t(m.roughnessTexture), tp).r;
     scratch->alpha = std::clamp(roughnessToAlpha(x, m.roughnessRemap), 1e-3f, 1.0f);

@@ -83,12 +83,22 @@ class Scene {
   // The material the BSDF sees at the hit: m itself, or (textured
   // parameters) a copy in `scratch` with the values at the hit: the
   // specular colour clamped to [0, 1] (a conductor's reflectance becomes
-  // its eta, k), the roughness remapped and clamped to [1e-3, 1] (never a
+  // its eta, k), a textured eta / k (clamped to eta >= 1e-3, k >= 0), a textured ior (>= 1), the roughness remapped and clamped to [1e-3, 1] (never a
   // delta lobe on a material classified non-delta). An empty optional costs
   // an untextured hit nothing.
   const Material& shadedMaterial(const Material& m, const Hit& hit, std::optional<Material>& scratch) const {
-    if (m.specularTexture < 0 && m.roughnessTexture < 0 && m.baseRoughnessTexture < 0) return m;
+    if (m.specularTexture < 0 && m.roughnessTexture < 0 && m.baseRoughnessTexture < 0 && m.etaTexture < 0 &&
+        m.kTexture < 0 && m.iorTexture < 0)
+      return m;
     return shadeTextured(m, hit, scratch);
+  }
+  // The material a hit on an object uses, seen from direction wo:
+  // resolveMaterial (material.h) with each mix's amount at the hit, its
+  // texture evaluated there when it has one (pbrt-v4's FloatTexture amount).
+  const Material& materialAt(const Hit& hit, Vec3f wo) const {
+    return resolveMaterial(materials.data(), objects[hit.object].material, hit.p, wo, [&](const Material& m) {
+      return m.amountTexture < 0 ? m.mixAmount : textures.eval(uint32_t(m.amountTexture), {uvAt(hit), hit.localP}).r;
+    });
   }
   // The raw ray tracer (benchmarks compare our tracing against it).
   const EmbreeScene& embree() const { return embree_; }
