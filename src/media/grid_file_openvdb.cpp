@@ -1,7 +1,8 @@
 // media/grid_file_openvdb.cpp — an OpenVDB .vdb file's float grid made
 // dense (grid_readers.h). The only file that includes OpenVDB (its headers
-// are slow to compile and bring Boost); built with OpenVDB's flags alone
-// (src/CMakeLists.txt).
+// are slow to compile and bring Boost); built, with grid_checks.cpp, as the
+// module libtdpm_openvdb.so that grid_file.cpp opens the first time a .vdb
+// is read (libopenvdb's start-up costs 0.1 s, see there).
 #include <mutex>
 
 #include <openvdb/io/File.h>
@@ -40,6 +41,7 @@ void mapOf(const openvdb::GridBase& grid, const scene::DensityGridDesc& g, const
 
 }  // namespace
 
+namespace {
 void readOpenVdb(scene::DensityGridDesc& g, const std::string& where, uint64_t maxBytes) {
   static std::once_flag once;
   std::call_once(once, [] { openvdb::initialize(); });
@@ -92,4 +94,19 @@ void readOpenVdb(scene::DensityGridDesc& g, const std::string& where, uint64_t m
   }
 }
 
+}  // namespace
 }  // namespace tdpm::media::detail
+
+// The module's entry (ReadOpenVdbFn): every refusal as text.
+extern "C" __attribute__((visibility("default"))) void tdpm_read_openvdb(tdpm::scene::DensityGridDesc* grid,
+                                                                         const std::string* where, uint64_t maxBytes,
+                                                                         std::string* error) {
+  static_assert(std::is_same_v<decltype(&tdpm_read_openvdb), tdpm::media::ReadOpenVdbFn>);
+  try {
+    tdpm::media::detail::readOpenVdb(*grid, *where, maxBytes);
+  } catch (const std::exception& e) {
+    *error = e.what();
+  } catch (...) {
+    *error = *where + ": density grid file \"" + grid->file + "\": unexpected failure in the OpenVDB reader";
+  }
+}

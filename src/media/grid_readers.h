@@ -1,8 +1,8 @@
-// media/grid_readers.h — internal to media/grid_file*.cpp: the two file
-// readers (OpenVDB in grid_file_openvdb.cpp, NanoVDB in
-// grid_file_nanovdb.cpp, the only files that include those libraries'
-// slow headers) and the checks they share (grid_file.cpp), so that both
-// formats refuse the same things with the same words.
+// media/grid_readers.h — internal to media/grid_*.cpp: the two file
+// readers (OpenVDB in grid_file_openvdb.cpp, a module opened on first use;
+// NanoVDB in grid_file_nanovdb.cpp; the only files that include those
+// libraries' slow headers) and the checks they share (grid_checks.cpp), so
+// that both formats refuse the same things with the same words.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -41,7 +41,13 @@ void checkDensities(const scene::DensityGridDesc& g, const std::string& where, c
 // "a", "b" and "c" for messages listing the grids a file holds.
 std::string listNames(const std::vector<std::string>& names);
 
-void readOpenVdb(scene::DensityGridDesc& g, const std::string& where, uint64_t maxBytes);
 void readNanoVdb(scene::DensityGridDesc& g, const std::string& where, uint64_t maxBytes, uint64_t fileSize);
 
 }  // namespace tdpm::media::detail
+
+namespace tdpm::media {
+// The OpenVDB reader module's one entry (libtdpm_openvdb.so, exported as
+// "tdpm_read_openvdb"): fills *grid as loadDensityGridFile does, or sets
+// *error to the located message. Nothing is thrown across it.
+using ReadOpenVdbFn = void (*)(scene::DensityGridDesc* grid, const std::string* where, uint64_t maxBytes, std::string* error);
+}  // namespace tdpm::media
