@@ -287,3 +287,16 @@ TEST_CASE("cli: tdpm convert writes a pbrt scene with media as JSON with its med
   CHECK(j["render"]["method"] == "pathtrace");
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("cli: without the OpenVDB module a .vdb grid is a located error, nothing written") {
+  std::string dir = test::makeTempDir();
+  test::writeFile(dir + "/smoke.vdb", "not read: the reader is missing\n");
+  test::writeFile(dir + "/f.pbrt", "WorldBegin\nMakeNamedMedium \"s\" \"string type\" \"nanovdb\" \"string filename\" \"smoke.vdb\"\n");
+  auto c = test::runShell("TDPM_OPENVDB_MODULE=" + dir + "/none.so '" + TDPM_BINARY + "' convert '" + dir + "/f.pbrt' -o '" + dir +
+                          "/f.json' -q");
+  CHECK(c.exitCode == 1);
+  CHECK(contains(c.output, dir + "/f.pbrt:2: MakeNamedMedium \"s\": density grid file \"" + dir +
+                               "/smoke.vdb\": OpenVDB support (libtdpm_openvdb.so) could not be loaded"));
+  CHECK_FALSE(test::fileExists(dir + "/f.json"));
+  std::filesystem::remove_all(dir);
+}

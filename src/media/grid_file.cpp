@@ -26,11 +26,12 @@ namespace {
 
 constexpr const char* kModule = "libtdpm_openvdb.so";
 
-// Where the module is looked for: $TDPM_OPENVDB_MODULE (a path), beside the
-// running executable, and the build folder it was built in.
+// Where the module is looked for: $TDPM_OPENVDB_MODULE (a path; then only
+// there), else beside the running executable and the build folder it was
+// built in.
 std::vector<std::string> moduleCandidates() {
   std::vector<std::string> out;
-  if (const char* env = std::getenv("TDPM_OPENVDB_MODULE"); env && *env) out.push_back(env);
+  if (const char* env = std::getenv("TDPM_OPENVDB_MODULE"); env && *env) return {env};
   std::error_code ec;
   std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
   if (!ec) {
