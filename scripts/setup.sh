@@ -25,6 +25,7 @@ packages=(g++ cmake make pkg-config
   doctest-dev nlohmann-json3-dev libtinyobjloader-dev libcli11-dev
   libnanoflann-dev libbenchmark-dev openimageio-tools
   libopenmpi-dev openmpi-bin  # distributed rendering under mpirun (docs/distributed.md)
+  libopenvdb-dev libnanovdb-dev libboost-iostreams-dev  # media density grid files (OpenVDB's headers need Boost)
   clang libclang-rt-14-dev)  # libFuzzer + sanitizer runtimes (scripts/fuzz.sh); only recommended by clang
 
 missing=()

@@ -73,12 +73,14 @@ TEST_CASE("pbrt bdpt and mlt: time where a delta light meets glass or a mirror, 
   CHECK(hasNote(q, "\"sigma\" ignored (quality only)"));
 }
 
-TEST_CASE("pbrt volpath without media is pathtrace; a medium still stops at its statement") {
+TEST_CASE("pbrt volpath is pathtrace (tdpm's path tracer traces media); a medium is imported") {
   pbrt::ImportResult r = importText("Integrator \"volpath\" \"integer maxdepth\" 4\n" + std::string(kPointAndDiffuse));
   CHECK(*r.scene.render.method == "pathtrace");
   CHECK(*r.scene.render.maxDepth == 4);
-  CHECK(test::errorMessageOf([] { importText("Integrator \"volpath\"\nWorldBegin\nMakeNamedMedium \"fog\"\n"); })
-            .find("dir/t.pbrt:3: statement MakeNamedMedium is not supported") != std::string::npos);
+  CHECK(hasNote(r, "Integrator \"volpath\" mapped to pathtrace"));
+  pbrt::ImportResult m = importText("Integrator \"volpath\"\nWorldBegin\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n");
+  CHECK(m.scene.media.size() == 1);
+  CHECK(*m.scene.render.method == "pathtrace");
 }
 
 TEST_CASE("pbrt sppm photonsperiteration -1: photons per pixel of the image rendered") {

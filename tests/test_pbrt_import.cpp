@@ -630,7 +630,7 @@ TEST_CASE("pbrt errors name file:line and the statement or parameter") {
       {"ReverseOrientation\nWorldBegin\n", "dir/t.pbrt:1: ReverseOrientation is only allowed after WorldBegin"},
       {"WorldBegin\nScale 2 1 1\nShape \"sphere\"\n", "dir/t.pbrt:3: Shape \"sphere\" under a non-uniform scale"},
       {"WorldBegin\nAreaLightSource \"diffuse\"\nShape \"disk\" \"float innerradius\" 0.5\n", "dir/t.pbrt:3: Shape \"disk\": an annulus"},
-      {"WorldBegin\nMakeNamedMedium \"fog\"\n", "dir/t.pbrt:2: statement MakeNamedMedium is not supported"},
+      {"WorldBegin\nMakeNamedMedium \"fog\"\n", "dir/t.pbrt:2: MakeNamedMedium \"fog\": missing parameter \"string type\""},
       {"WorldBegin\nAttributeBegin\n", "dir/t.pbrt:2: AttributeBegin without a matching End"},
       {"WorldBegin\nAttributeEnd\n", "dir/t.pbrt:2: AttributeEnd without a matching AttributeBegin"},
       {"WorldBegin\nNamedMaterial \"x\"\n", "dir/t.pbrt:2: NamedMaterial: no material named \"x\""},

@@ -354,6 +354,19 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
       if (!inv) failAt(at, "Camera: the current transform is singular");
     }
     coordSystems_["camera"] = *gs_.ctm[0].inverse();
+    // pbrt (v3 and v4): the camera sits in the outside medium current at Camera.
+    cameraMedium_ = gs_.mediumOutside;
+    cameraMediumAt_ = gs_.mediumOutside.empty() ? at : gs_.mediumAt;
+  } else if (s == "MakeNamedMedium") {
+    std::string name = c.string(s);
+    makeNamedMedium(name, c.params("MakeNamedMedium \"" + name + "\""), at);
+  } else if (s == "MediumInterface") {
+    // One name: the same medium on both sides (pbrt-v4); two: inside, outside.
+    std::string inside = c.string(s), outside = inside;
+    if (!c.done() && c.peek().kind == Token::Kind::String) outside = c.string(s);
+    gs_.mediumInside = inside;
+    gs_.mediumOutside = outside;
+    gs_.mediumAt = at;
   } else if (s == "Film" || s == "Sampler" || s == "Integrator" || s == "PixelFilter") {
     requireOptions(at, s);
     std::string type = c.string(s);
@@ -423,7 +436,11 @@ void Importer::statement(Cursor& c, const Token& word, int depth) {
   } else if (s == "LightSource") {
     requireWorld(at, s);
     std::string type = c.string(s);
+    size_t before = result.scene.lights.size();
     lightSource(type, c.params("LightSource \"" + type + "\""), at);
+    // pbrt: a light sits in the outside medium current at its statement.
+    for (size_t i = before; i < result.scene.lights.size(); ++i)
+      lightMedium(gs_.mediumOutside, gs_.mediumAt, i, result.scene.lights[i].name);
   } else if (s == "AreaLightSource") {
     requireWorld(at, s);
     std::string type = c.string(s);
@@ -727,9 +744,10 @@ void Importer::worldBegin(const Loc& at) {
       }
   };
   if (integ == "path" || integ == "volpath") {
-    // volpath without media is path tracing; a medium statement is refused
-    // where it stands (media are another issue).
+    // tdpm's pathtrace is a volumetric path tracer (delta and ratio
+    // tracking, next-event estimation through media, MIS): pbrt's volpath.
     r.method = "pathtrace";
+    if (integ == "volpath") note(iat, "Integrator \"volpath\" mapped to pathtrace (tdpm's path tracer traces media)");
     qualityOnly({"regularize", "lightsampler", "rrthreshold"});
   } else if (integ == "directlighting") {
     r.method = "pathtrace";
@@ -835,6 +853,7 @@ void Importer::finish(const std::string& file) {
                            "; the import scales every light by it");
   }
   if (bidirectional_) chooseBidirectionalMethod();
+  resolveMedia();
   validateAsJson();
 }
 

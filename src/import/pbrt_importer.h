@@ -57,6 +57,9 @@ struct ShapeRecord {
   // pbrt's ReverseOrientation in effect for this shape (as written: an
   // emitter's side and ShapeDesc::reverseOrientation derive from it).
   bool reverseOrientation = false;
+  // The MediumInterface in effect ("" = vacuum) and where it was given.
+  std::string mediumInside, mediumOutside;
+  Loc mediumAt;
 };
 
 struct GraphicsState {
@@ -65,6 +68,11 @@ struct GraphicsState {
   int material = 0;
   std::optional<AreaLight> area;
   bool reverseOrientation = false;  // toggled by ReverseOrientation; restored by AttributeEnd
+  // MediumInterface "inside" "outside" (names of MakeNamedMedium, "" =
+  // vacuum); restored by AttributeEnd. Resolved at the end of the import
+  // (pbrt-v4 allows a medium to be made after it is named).
+  std::string mediumInside, mediumOutside;
+  Loc mediumAt;
 };
 
 struct StackEntry {
@@ -92,6 +100,10 @@ struct Statement {  // an options-block statement kept until WorldBegin
 
 class Cursor;
 
+// Turns a trianglemesh's windings to face its shading normals N, as pbrt
+// orients such a triangle (pbrt_mapping.cpp); false when it has no N.
+bool facesShadingNormals(const ShapeRecord& rec, const std::vector<Vec3f>& verts, std::vector<uint32_t>* indices);
+
 class Importer {
  public:
   ImportResult result;
@@ -117,6 +129,31 @@ class Importer {
   void environmentLight(const ParamSet& ps, const Mat& M, const Loc& at);
   void texture(const std::string& name, const std::string& kind, const std::string& type, const ParamSet& ps, const Loc& at);
   MaterialSlot makeMaterial(const std::string& type, const ParamSet& ps, const Loc& at, const std::string& name);
+
+  // participating media (pbrt_media.cpp)
+  void makeNamedMedium(const std::string& name, const ParamSet& ps, const Loc& at);
+  void mediumCoefficients(scene::MediumDesc& m, const ParamSet& ps, const std::string& what, bool v3);
+  void mediumPlacement(scene::MediumDesc& m, const Loc& at, const std::string& what);
+  void mediumGrid(scene::MediumDesc& m, const std::string& type, const ParamSet& ps, const Loc& at, const std::string& what);
+  // A name a shape, light or the camera uses, resolved by resolveMedia()
+  // once every statement is read (then -1 for "", the index otherwise).
+  struct MediumRef {
+    enum class Kind { ObjectInside, ObjectOutside, Light, Camera };
+    Kind kind;
+    size_t index;  // into scene.objects / scene.lights
+    std::string name;
+    Loc at;        // the MediumInterface (or Camera) statement
+    std::string user;  // "Shape \"sphere\" at f:12", for the message
+  };
+  std::vector<MediumRef> mediumRefs_;
+  void objectMedia(const ShapeRecord& rec, size_t object);
+  void lightMedium(const std::string& outside, const Loc& at, size_t light, const std::string& user);
+  void resolveMedia();
+  uint32_t interfaceMaterialIndex();
+  std::map<std::string, int> namedMedia_;  // name -> index in scene.media
+  std::string cameraMedium_;
+  Loc cameraMediumAt_;
+  int interfaceMaterial_ = -1;
 
   // mapping
   void emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& instanceAt);
@@ -183,7 +220,9 @@ class Importer {
   std::map<std::string, std::vector<ShapeRecord>> instances_;
   std::vector<ShapeRecord>* currentInstance_ = nullptr;
   std::string currentInstanceName_;
-  std::set<std::string> materialNames_;
+  // "interface" is the JSON's reserved name of the no-surface material
+  // (interfaceMaterialIndex); a pbrt material of that name becomes "interface#2".
+  std::set<std::string> materialNames_ = {"interface"};
   std::set<std::string> notedKinds_;
 
   // budgets (scene/limits.h)

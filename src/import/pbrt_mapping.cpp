@@ -616,7 +616,8 @@ void Importer::environmentLight(const ParamSet& ps, const Mat& M, const Loc& at)
 // ------------------------------------------------------------ shapes
 
 void Importer::shape(const std::string& type, ParamSet params, const Loc& at) {
-  ShapeRecord rec{type, std::move(params), {gs_.ctm[0], gs_.ctm[1]}, gs_.material, gs_.area, at, gs_.reverseOrientation};
+  ShapeRecord rec{type, std::move(params), {gs_.ctm[0], gs_.ctm[1]}, gs_.material, gs_.area, at, gs_.reverseOrientation,
+                  gs_.mediumInside, gs_.mediumOutside, gs_.mediumAt};
   if (currentInstance_) {
     if (rec.area) failAt(at, "Shape: area lights inside an object definition are not supported (pbrt ignores them too)");
     currentInstance_->push_back(std::move(rec));
@@ -955,7 +956,9 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
     }
     return;
   }
-  if (mat.interface) return;  // no surface: invisible without participating media
+  // pbrt's "interface" material: no surface. A boundary between two media
+  // is kept (an Interface object); without media it is dropped (invisible).
+  if (mat.interface && rec.mediumInside == rec.mediumOutside) return;
   scene::ObjectDesc o;
   o.name = "Shape \"" + rec.type + "\" (" + rec.at.str() + (instanceAt.file.empty() ? "" : ", instance at " + instanceAt.str()) + ")";
   MotionPlan plan = planMotion(ctm, rec.at, "Shape \"" + rec.type + "\"");
@@ -1001,6 +1004,10 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
     // (the winding is kept through mirrors below), then ReverseOrientation.
     o.shape.reverseOrientation = rec.reverseOrientation;
     o.shape.indices = g.indices;
+    // A medium boundary's sides are pbrt's: shading normals N, when given,
+    // decide them per triangle (before the bake, which keeps the agreement).
+    if (rec.mediumInside != rec.mediumOutside && facesShadingNormals(rec, g.vertices, &o.shape.indices))
+      o.shape.reverseOrientation = false;
     o.shape.loopLevels = g.loopLevels;  // placements are affine: refining after baking them is exact
     if (!plan.moving) {
       // Bake the placement into the vertices (any affine map is exact). A
@@ -1021,9 +1028,10 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
     if (g.uv.size() == g.vertices.size() && g.loopLevels < 0)
       for (uint32_t i : o.shape.indices) o.shape.uvs.push_back(g.uv[i]);
   }
-  o.material = materialIndex(rec.material);
+  o.material = mat.interface ? interfaceMaterialIndex() : materialIndex(rec.material);
   result.scene.objects.push_back(std::move(o));
   objectAt_.push_back(rec.at);
+  objectMedia(rec, result.scene.objects.size() - 1);
 }
 
 // pbrt's DiffuseAreaLight radiance: L x scale, or pbrt-v4's "power" (W)
@@ -1041,6 +1049,12 @@ Rgb Importer::areaLightL(const ShapeRecord& rec, double area, bool twoSided) {
 
 void Importer::pushAreaLight(const ShapeRecord& rec, scene::LightDesc l) {
   const MaterialSlot& mat = materials_[size_t(rec.material)];
+  // An emitter sends its light into the medium on its emitting side, pbrt's
+  // outside (the side its normal faces, which is the side that emits).
+  if (rec.mediumInside != rec.mediumOutside && l.twoSided)
+    failAt(rec.at, l.name + ": a two-sided emitter between two media (MediumInterface at " + rec.mediumAt.str() +
+                       ") is not supported: tdpm's lights emit into one medium");
+  lightMedium(rec.mediumOutside, rec.mediumAt, result.scene.lights.size(), l.name);
   bool black = mat.interface || (mat.desc.type == scene::MaterialDesc::Type::Diffuse && mat.desc.albedo.color.isBlack());
   if (!black) note(rec.at, l.name + ": tdpm's area lights do not reflect light; the emitter's material is ignored");
   result.scene.lights.push_back(std::move(l));
@@ -1107,21 +1121,27 @@ void Importer::emitRoundLight(const ShapeRecord& rec, const Mat ctm[2]) {
   pushAreaLight(rec, std::move(l));
 }
 
+// Flips the windings that disagree with the triangle mesh's shading normals
+// N (object space); false (nothing done) when it has none.
+bool facesShadingNormals(const ShapeRecord& rec, const std::vector<Vec3f>& verts, std::vector<uint32_t>* indices) {
+  if (rec.type != "trianglemesh" || !rec.params.has("N")) return false;
+  std::vector<double> N = rec.params.getFloats("N");
+  if (N.size() != 3 * verts.size()) return false;  // pbrt would refuse; tdpm ignores N (noted)
+  auto n = [&](uint32_t i) { return Vec3f{float(N[3 * i]), float(N[3 * i + 1]), float(N[3 * i + 2])}; };
+  std::vector<uint32_t>& idx = *indices;
+  for (size_t t = 0; t + 2 < idx.size(); t += 3) {
+    Vec3f g = cross(verts[idx[t + 1]] - verts[idx[t]], verts[idx[t + 2]] - verts[idx[t]]);
+    if (dot(g, n(idx[t]) + n(idx[t + 1]) + n(idx[t + 2])) < 0) std::swap(idx[t + 1], idx[t + 2]);
+  }
+  return true;
+}
+
 // pbrt turns a triangle with shading normals N to face them (and then
 // ignores ReverseOrientation): a one-sided mesh emitter's windings are
 // flipped where they disagree with the sum of their vertices' N (object
 // space; the bake keeps the agreement, normals transforming alike).
 static void orientByShadingNormals(const ShapeRecord& rec, const std::vector<Vec3f>& verts, scene::LightDesc* l) {
-  if (rec.type != "trianglemesh" || !rec.params.has("N")) return;
-  std::vector<double> N = rec.params.getFloats("N");
-  if (N.size() != 3 * verts.size()) return;  // pbrt would refuse; tdpm ignores N (noted)
-  auto n = [&](uint32_t i) { return Vec3f{float(N[3 * i]), float(N[3 * i + 1]), float(N[3 * i + 2])}; };
-  std::vector<uint32_t>& idx = l->mesh.indices;
-  for (size_t t = 0; t + 2 < idx.size(); t += 3) {
-    Vec3f g = cross(verts[idx[t + 1]] - verts[idx[t]], verts[idx[t + 2]] - verts[idx[t]]);
-    if (dot(g, n(idx[t]) + n(idx[t + 1]) + n(idx[t + 2])) < 0) std::swap(idx[t + 1], idx[t + 2]);
-  }
-  l->reverseOrientation = false;
+  if (facesShadingNormals(rec, verts, &l->mesh.indices)) l->reverseOrientation = false;
 }
 
 // A triangle mesh with an AreaLightSource: a rectangle light when it is one

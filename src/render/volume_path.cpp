@@ -201,7 +201,7 @@ Rgb PathTracer::traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& sample
     }
     // ---- a surface vertex ----
     if (depth == lastDepth) break;
-    const Material& mat = resolveMaterial(scene_.materials.data(), obj.material, hit.p, -dir);
+    const Material& mat = scene_.materialAt(hit, -dir);
     std::optional<Material> textured;
     ShadingContext ctx = makeShadingContext(scene_.shadedMaterial(mat, hit, textured), scene_.albedoAt(mat, hit), hit.n, -dir);
     if (directOnly_ && !mat.isDeltaOnly()) lastDepth = std::min(lastDepth, depth + 1);

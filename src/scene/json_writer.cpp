@@ -256,6 +256,48 @@ std::string objText(const scene::ShapeDesc& s) {
   return out;
 }
 
+// ---- participating media (media-format.md: the keys M1's parser reads)
+
+// A medium reference: its name, or null for vacuum.
+Json mediumRef(const scene::SceneDescription& sc, int32_t i) {
+  if (i < 0) return nullptr;
+  return sc.media.at(size_t(i)).name;
+}
+
+Json medium(const scene::MediumDesc& m, const std::filesystem::path& jp) {
+  Json j;
+  bool grid = m.type == scene::MediumDesc::Type::Grid;
+  j["type"] = grid ? "grid" : "homogeneous";
+  j["sigma_a"] = rgb(m.sigmaA);
+  j["sigma_s"] = rgb(m.sigmaS);
+  j["scale"] = num(m.scale);
+  j["g"] = num(m.g);
+  if (!grid) return j;
+  const scene::DensityGridDesc& g = m.grid;
+  if (!g.file.empty()) {
+    // By reference: the parser reads the file again (grid_file.h).
+    j["file"] = relativeToJson(g.file, jp);
+    j["grid"] = g.gridName;
+  } else {
+    j["resolution"] = Json::array({g.nx, g.ny, g.nz});
+    Json d = Json::array();
+    for (float v : g.density) d.push_back(num(v));
+    j["density"] = d;
+  }
+  // Always written: for a file these are the grid's own world bounds, which
+  // the parser would compute, so the written value is the same.
+  j["bounds"] = Json::array({vec(g.bounds.lo), vec(g.bounds.hi)});
+  Json t = transform(m.placement);
+  if (!t.empty()) j["transform"] = t;
+  return j;
+}
+
+// "medium" of the camera and of a light: written when it differs from the
+// JSON's default (the exterior medium); null is vacuum.
+void defaultedMedium(Json& j, const scene::SceneDescription& sc, int32_t i) {
+  if (i != sc.exteriorMedium) j["medium"] = mediumRef(sc, i);
+}
+
 const char* lightType(const scene::LightDesc& l) {
   if (l.type == scene::LightDesc::Type::Area) {
     switch (l.areaShape) {
@@ -337,7 +379,17 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
     cam["lens_radius"] = num(c.lensRadius);
     cam["focal_distance"] = num(c.focalDistance);
   }
+  defaultedMedium(cam, sc, c.medium);
   root["camera"] = cam;
+  if (!sc.media.empty()) {
+    Json media = Json::object();
+    for (const auto& m : sc.media) {
+      if (m.name.empty() || media.contains(m.name)) throw Error(jsonPath + ": two media are named \"" + m.name + "\" (or one has no name)");
+      media[m.name] = medium(m, jp);
+    }
+    root["media"] = media;
+  }
+  if (sc.exteriorMedium >= 0) root["exterior_medium"] = mediumRef(sc, sc.exteriorMedium);
   std::vector<std::string> texNames = textureNames(sc.textures);
   if (!sc.textures.empty()) {
     Json textures = Json::object();
@@ -382,6 +434,9 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
     Json t = transform(o.placement);
     if (!t.empty()) j["transform"] = t;
     if (!o.motion.empty()) j["motion"] = motion(o.motion);
+    // The general form always (the "medium" sugar reads back to the same).
+    if (o.media.present)
+      j["medium_interface"] = Json{{"inside", mediumRef(sc, o.media.inside)}, {"outside", mediumRef(sc, o.media.outside)}};
     objects.push_back(j);
   }
   root["objects"] = objects;
@@ -434,6 +489,7 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
     Json t = transform(l.placement);
     if (!t.empty()) j["transform"] = t;
     if (!l.motion.empty()) j["motion"] = motion(l.motion);
+    defaultedMedium(j, sc, l.medium);
     lights.push_back(j);
   }
   root["lights"] = lights;
