@@ -31,45 +31,6 @@ long indexAfter(const std::string& path, const std::string& prefix) {
   return end && *end == ']' ? i : -1;
 }
 
-// The media, the media references and the "interface" materials, taken out
-// of the scene while it is checked as JSON and put back after (also when
-// the check throws). The importer checks media itself (pbrt_media.cpp: the
-// JSON's limits: coefficients, g, densities, grid sizes); this branch's
-// JSON parser predates the media keys (issue 25's parser comes with
-// M1's branch). Once the parser reads them, this set-aside can go and the
-// media be checked as JSON too.
-struct MediaSetAside {
-  scene::SceneDescription& sc;
-  std::vector<scene::MediumDesc> media;
-  int32_t exterior, camera;
-  std::vector<int32_t> lights;
-  std::vector<scene::MediumInterfaceDesc> objects;
-  std::vector<size_t> interfaces;
-  explicit MediaSetAside(scene::SceneDescription& s) : sc(s), exterior(s.exteriorMedium), camera(s.camera.medium) {
-    media.swap(sc.media);
-    sc.exteriorMedium = sc.camera.medium = -1;
-    for (auto& l : sc.lights) lights.push_back(std::exchange(l.medium, -1));
-    for (auto& o : sc.objects) objects.push_back(std::exchange(o.media, scene::MediumInterfaceDesc{}));
-    for (size_t i = 0; i < sc.materials.size(); ++i)
-      if (sc.materials[i].type == scene::MaterialDesc::Type::Interface) {
-        interfaces.push_back(i);
-        // A diffuse stand-in (no key of its own to check), renamed: "interface" is reserved for the type.
-        sc.materials[i].type = scene::MaterialDesc::Type::Diffuse;
-        sc.materials[i].name += "#stand-in";
-      }
-  }
-  ~MediaSetAside() {
-    media.swap(sc.media);
-    sc.exteriorMedium = exterior;
-    sc.camera.medium = camera;
-    for (size_t i = 0; i < lights.size(); ++i) sc.lights[i].medium = lights[i];
-    for (size_t i = 0; i < objects.size(); ++i) sc.objects[i].media = objects[i];
-    for (size_t i : interfaces) {
-      sc.materials[i].type = scene::MaterialDesc::Type::Interface;
-      sc.materials[i].name.resize(sc.materials[i].name.size() - 9);  // "#stand-in"
-    }
-  }
-};
 
 }  // namespace
 
@@ -110,7 +71,6 @@ void Importer::validateAsJson() {
   auto meshShape = [&](scene::SceneDescription& d, size_t k) -> scene::ShapeDesc& {
     return meshObject[k].first ? d.lights[meshObject[k].second].mesh : d.objects[meshObject[k].second].shape;
   };
-  MediaSetAside aside(sc);
   SceneJson js = sceneToJson(sc, stem + ".json", /*meshText=*/false);
   const std::string meshPrefix = stem + ".mesh";
   scene::MeshSource meshes = [&](const std::string& file, std::vector<Vec3f>* v, std::vector<uint32_t>* idx) {
