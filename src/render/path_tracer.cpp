@@ -27,7 +27,7 @@ constexpr int kGuidedDiffuseVertices = 2;
 // inner loop; its throughput, MIS state and running sum stay local to it
 // instead of passing through a call per vertex.
 template <class Stream>
-Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState&) const {
+Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts) const {
   if (scene_.hasMedia()) return traceMedia(origin, dir, time01, sampler);
   Rgb L(0.0f), beta(1.0f);
   // Product of eta^2 over the refractions so far: the radiance scaling
@@ -53,6 +53,7 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
   // it for max_depth 1). pbrt's maxdepth counts the same way.
   // directOnly_: the first non-delta vertex is the last to scatter.
   int lastDepth = maxDepth_;
+  GuideCones& cones = ts.cones;  // this vertex's guide, cleared per vertex
   for (int depth = 0;; ++depth) {
     Hit hit;
     if (!scene_.intersect(origin, dir, std::numeric_limits<float>::infinity(), time01, hit)) {
@@ -83,7 +84,7 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
     // only, such paths made 27% and 11% of cube-caustic's relMSE at 1024
     // spp (seeds 1 and 2). The guide's occupancy grid answers for most
     // vertices, away from every caustic, without a k-NN.
-    GuideCones cones;
+    cones.clear();
     if (guide_ && !mat.isDeltaOnly() && diffuseVertices < kGuidedDiffuseVertices)
       guide_->conesAt(mat, hit.p, ctx.frame.n, cones);
     if (!mat.isDeltaOnly()) ++diffuseVertices;

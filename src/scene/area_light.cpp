@@ -74,11 +74,6 @@ AreaLightFrame computeAreaLightFrame(const Light& light, float time01) {
   return f;
 }
 
-Rgb areaLightRadiance(const Light& light, const AreaLightFrame& f, Vec3f n, Vec3f dirFromLight) {
-  if (!light.twoSided && dot(n, dirFromLight) <= 0) return Rgb(0.0f);
-  return f.radiance;
-}
-
 Vec3f areaLightNormal(const Light& light, const AreaLightFrame& f, Vec3f p, uint32_t primitive) {
   float sign = light.reversed ? -1.0f : 1.0f;
   switch (light.shape) {
@@ -200,7 +195,15 @@ bool sampleAreaLight(const Light& light, const AreaLightFrame& f, Vec3f p, Vec2f
     out.pdf = 1.0f / (2.0f * kPi * omc);
     return !out.li.isBlack() && out.distance > 0;
   }
-  if (!sampleAreaLightPoint(light, f, u, q, n)) return false;
+  if (light.shape == Light::AreaShape::Rect) {
+    // The common case without the point sampler's call and switch (the
+    // same arithmetic as sampleAreaLightPoint's rectangle).
+    if (!(f.area > 0)) return false;
+    q = f.center + f.edgeX * (u.x - 0.5f) + f.edgeZ * (u.y - 0.5f);
+    n = f.normal;
+  } else if (!sampleAreaLightPoint(light, f, u, q, n)) {
+    return false;
+  }
   Vec3f d = q - p;
   float dist2 = lengthSquared(d);
   if (!(dist2 > 0)) return false;

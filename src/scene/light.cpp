@@ -92,7 +92,11 @@ bool sampleLight(const Light& light, Vec3f p, float time01, Vec2f u, LightSample
       out.pdf = 1.0f;
       return true;
     }
-    case Light::Type::Area: return sampleAreaLight(light, areaLightFrame(light, time01), p, u, out);
+    case Light::Type::Area:
+      // A still light's frame by reference: copying it per sample was a
+      // measurable part of next-event estimation.
+      if (light.hasStillFrame) return sampleAreaLight(light, light.stillFrame, p, u, out);
+      return sampleAreaLight(light, computeAreaLightFrame(light, time01), p, u, out);
     case Light::Type::Environment:
       out.distance = std::numeric_limits<float>::infinity();
       return light.env->sample(u, out.wi, out.li, out.pdf);

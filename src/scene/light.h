@@ -90,7 +90,10 @@ AreaLightFrame areaLightFrame(const Light& light, float time01);
 // Emitted radiance of an area light leaving a point with emitting-side
 // normal n (Hit::n of a ray that hit the light) along dirFromLight: the
 // frame's radiance on the emitting side (both sides when twoSided), else 0.
-Rgb areaLightRadiance(const Light& light, const AreaLightFrame& f, Vec3f n, Vec3f dirFromLight);
+inline Rgb areaLightRadiance(const Light& light, const AreaLightFrame& f, Vec3f n, Vec3f dirFromLight) {
+  if (!light.twoSided && dot(n, dirFromLight) <= 0) return Rgb(0.0f);
+  return f.radiance;
+}
 // The emitting-side unit normal at world point p on the light (primitive:
 // the triangle of a mesh emitter), for Scene::intersect.
 Vec3f areaLightNormal(const Light& light, const AreaLightFrame& f, Vec3f p, uint32_t primitive);
