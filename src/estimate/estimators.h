@@ -212,13 +212,7 @@ class Gatherer {
   int boundaryFirst(int found, int k, float maxR2) {
     if (found == k) return 1;  // full heap: the root is the farthest
     if (std::isfinite(maxR2) || found == 0) return 0;
-    uint32_t* idx = query_.index();
-    float* d2 = query_.dist2();
-    int far = 0;
-    for (int i = 1; i < found; ++i)
-      if (d2[i] > d2[far]) far = i;
-    std::swap(idx[0], idx[far]);
-    std::swap(d2[0], d2[far]);
+    photon::moveFarthestFirst(query_, found);
     return 1;
   }
   template <class K1, class Brdf>

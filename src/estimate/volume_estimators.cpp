@@ -43,13 +43,7 @@ int VolumeGatherer::nearest(Vec3f x, int k, float& r2) {
   r2 = std::max(r2, opt_.minRadius2);
   if (found == k) return 1;           // full heap: the root is the k-th, on the boundary
   if (std::isfinite(maxR2)) return 0;  // a known ball: all of it counted
-  uint32_t* idx = knn_.index();
-  float* d2 = knn_.dist2();
-  int far = 0;
-  for (int i = 1; i < found; ++i)
-    if (d2[i] > d2[far]) far = i;
-  std::swap(idx[0], idx[far]);
-  std::swap(d2[0], d2[far]);
+  photon::moveFarthestFirst(knn_, found);  // the boundary photon, as Gatherer::boundaryFirst
   return 1;
 }
 

@@ -16,6 +16,7 @@
 #pragma once
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "math/vec.h"
@@ -64,6 +65,19 @@ class KnnQuery {
   };
   std::vector<StackEntry> stack_;  // never deeper than the tree
 };
+
+// Moves the farthest of the first `found` results to slot 0 (a swap of
+// index and distance): the estimators that leave out the photon on the
+// search ball's boundary (the (k-1)/V rule) skip slot 0 after this.
+inline void moveFarthestFirst(KnnQuery& q, int found) {
+  uint32_t* idx = q.index();
+  float* d2 = q.dist2();
+  int far = 0;
+  for (int i = 1; i < found; ++i)
+    if (d2[i] > d2[far]) far = i;
+  std::swap(idx[0], idx[far]);
+  std::swap(d2[0], d2[far]);
+}
 
 // Reusable per-thread results of a fixed-radius query (KdTree::range): every
 // photon within the radius, in traversal order. The arrays grow to the

@@ -331,10 +331,7 @@ class SegmentTimeline {
       grid.storeT1 = t1;
       grid.storedPerPath = rate;
       photon::TraceResult r = photon::traceSegmentPhotons(scene_, ts, grid, framed_);
-      addWarning(stats_, r.warning);
-      emitted_ += r.emitted;
-      stats_.maps[kind].stored += r.store.size();
-      stats_.maps[kind].emitted += r.emitted;
+      countTrace(kind, r);
       stats_.sharedPhotons += r.store.size();
       shared_.stores[kind] = std::move(r.store);
     }
@@ -355,6 +352,13 @@ class SegmentTimeline {
   uint64_t emitted() const { return emitted_; }
 
  private:
+  // What every trace of a map adds to the totals (shared sets and segments).
+  void countTrace(MapKind kind, const photon::TraceResult& r) {
+    addWarning(stats_, r.warning);
+    emitted_ += r.emitted;
+    stats_.maps[kind].stored += r.store.size();
+    stats_.maps[kind].emitted += r.emitted;
+  }
   // Pilot: stored photons per path, once per frame period and kind, over
   // that frame's time map (the caustic map aims at where the specular
   // objects are then). Segments of the period size their emission by it,
@@ -418,10 +422,7 @@ class SegmentTimeline {
       grid.storeT1 = float(double(lo + photon::kTimeBins) * grid_.binWidth);
       grid.storedPerPath = rate;
       photon::TraceResult r = photon::traceSegmentPhotons(scene_, ts, grid, framed_);
-      addWarning(stats_, r.warning);
-      emitted_ += r.emitted;
-      stats_.maps[kind].stored += r.store.size();
-      stats_.maps[kind].emitted += r.emitted;
+      countTrace(kind, r);
       stats_.segmentPaths += r.emitted;
       stats_.segmentPhotons += r.store.size();
       if (pad) {

@@ -43,6 +43,22 @@ inline bool bsdfAlone(const Light& light) {
 // heuristic (fullWeight: a camera or delta-sampled ray, which light
 // sampling could not have made). Zero without environment lights.
 // bsdfSamples >= 1 (the escaping ray is one of them).
+// A BSDF-sampled ray (or a camera ray) that hits an area light: its
+// radiance le and the MIS weight w against the light sample taken at lastP
+// (1 after a delta bounce or from the camera, lastDelta), as both path
+// tracers add it (render/path_tracer.cpp, render/volume_path.cpp); false
+// when le is black. The caller adds beta * le * w itself, so that the
+// product rounds as it always has (bench/bitmatch).
+inline bool areaEmissionOnHit(const Scene& scene, const Hit& hit, Vec3f dir, float time01, Vec3f lastP, float lastPdf,
+                              bool lastDelta, Rgb& le, float& w) {
+  const Light& light = scene.lights[size_t(hit.light)];
+  AreaLightFrame f = areaLightFrame(light, time01);
+  le = areaLightRadiance(light, f, hit.n, -dir);
+  if (le.isBlack()) return false;
+  w = lastDelta ? 1.0f : emissionWeight(lastPdf, areaLightPdf(light, f, lastP, hit.p, hit.n), 1);
+  return true;
+}
+
 inline Rgb environmentEmission(const Scene& scene, Vec3f dir, float bsdfPdf, int bsdfSamples, bool fullWeight) {
   Rgb sum(0.0f);
   for (uint32_t i : scene.environmentLights) {

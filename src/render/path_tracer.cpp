@@ -63,13 +63,9 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
     }
     // ---- emission: a BSDF-sampled ray that hits an area light ----
     if (hit.isLight()) {
-      const Light& light = scene_.lights[size_t(hit.light)];
-      AreaLightFrame f = areaLightFrame(light, time01);
-      Rgb le = areaLightRadiance(light, f, hit.n, -dir);
-      if (!le.isBlack()) {
-        float w = lastDelta ? 1.0f : emissionWeight(lastPdf, areaLightPdf(light, f, lastP, hit.p, hit.n), 1);
-        L += beta * le * w;
-      }
+      Rgb le;
+      float w;
+      if (areaEmissionOnHit(scene_, hit, dir, time01, lastP, lastPdf, lastDelta, le, w)) L += beta * le * w;
       break;  // emitters do not reflect
     }
     if (depth == lastDepth) break;

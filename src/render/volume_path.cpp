@@ -183,13 +183,9 @@ Rgb PathTracer::traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& sample
       break;
     }
     if (hit.isLight()) {  // ---- emission, attenuated by beta's media ----
-      const Light& light = scene_.lights[size_t(hit.light)];
-      AreaLightFrame f = areaLightFrame(light, time01);
-      Rgb le = areaLightRadiance(light, f, hit.n, -dir);
-      if (!le.isBlack()) {
-        float w = lastDelta ? 1.0f : emissionWeight(lastPdf, areaLightPdf(light, f, lastP, hit.p, hit.n), 1);
-        L += beta * le * w;
-      }
+      Rgb le;
+      float w;
+      if (areaEmissionOnHit(scene_, hit, dir, time01, lastP, lastPdf, lastDelta, le, w)) L += beta * le * w;
       break;
     }
     const SceneObject& obj = scene_.objects[hit.object];
