@@ -688,7 +688,10 @@ TraceResult traceMap(const Scene& scene, const TraceSettings& settings, const Tr
   TDPM_ASSERT(settings.invariant == InvariantPhotons::All || settings.motion, "time-invariance needs the motion bounds");
   if (settings.storedWanted == 0 || tracer.lights.empty()) return result;
   if (settings.kind == MapKind::Caustic && !sceneHasSpecular(scene, settings.glossyCaustics)) return result;
-  const char* stage = settings.kind == MapKind::Caustic ? "caustic photons" : "global photons";
+  if (settings.kind == MapKind::Volume && !scene.hasMedia()) return result;  // nowhere to scatter
+  const char* stage = settings.kind == MapKind::Caustic  ? "caustic photons"
+                      : settings.kind == MapKind::Global ? "global photons"
+                                                         : "volume photons";
   const PathRange& range = extras.range;
   if (range.paths > 0) {
     // A progressive pass: the count is fixed (pass 0's pilot chose it).

@@ -551,7 +551,8 @@ void prepareState(ProgressiveState& state, const RenderOptions& opt, int w, int 
                       {"gather", std::to_string(opt.gatherRays)},
                       {"k", std::to_string(opt.estimate.k)},
                       {"resolution", std::to_string(w) + "x" + std::to_string(h)}};
-    for (MapKind k : kAllMapKinds) state.settings[mapKindInfo(k).optionName] = std::to_string(opt.*mapKindInfo(k).photons);
+    for (MapKind k : kAllMapKinds)
+      if (mapKindInUse(opt, k)) state.settings[mapKindInfo(k).optionName] = std::to_string(opt.*mapKindInfo(k).photons);
   }
 }
 

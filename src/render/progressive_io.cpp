@@ -46,9 +46,15 @@ std::vector<std::string> splitNames(const std::string& s) {
 std::vector<ProgressiveScalar> progressiveScalars(const ProgressiveState& s) {
   using R = ProgressiveScalarRole;
   std::vector<ProgressiveScalar> v;
+  // The volume map (onlyWhenAsked) is not part of progressive states:
+  // progressive renders of scenes with media are refused
+  // (render/renderer.cpp checkMediaSupport), so states keep their format.
+  auto inState = [](MapKind k) { return !mapKindInfo(k).onlyWhenAsked; };
   for (MapKind k : kAllMapKinds)
+    if (inState(k))
     v.push_back({std::string("photons.") + mapKindName(k) + "_paths_per_pass", R::Paths, k, &s.pilot.maps[k].pathsPerPass});
   for (MapKind k : kAllMapKinds) {
+    if (!inState(k)) continue;
     const std::string p = std::string("kernel.") + mapKindName(k) + ".";
     const ProgressiveMapPilot& m = s.pilot.maps[k];
     v.push_back({p + "radius_1", R::Kernel, k, &m.radius});
