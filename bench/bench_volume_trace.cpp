@@ -37,7 +37,7 @@ void BM_FogBallTrace(benchmark::State& state) {
   const int kind = int(state.range(0));
   auto s = fogBall(kind != 2);
   photon::TraceSettings ts;
-  ts.kind = kind == 0 ? MapKind::Volume : MapKind::Global;
+  ts.kind = kind == 0 ? photon::MapKind::Volume : photon::MapKind::Global;
   ts.storedWanted = 100000;
   ts.maxBounces = 8;
   ts.seed = 1;

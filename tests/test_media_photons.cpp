@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_harness.h"
 #include "core/rng.h"
 #include "photon/tracer.h"
 #include "render/photon_map.h"
@@ -310,4 +311,22 @@ TEST_CASE("media photons: the render builds a beam map for the volume kind, none
   CHECK(!mapKindInUse(plainOpt, MapKind::Volume));
   CHECK(mapKindInUse(plainOpt, MapKind::Global));
   CHECK(photonsWanted(plainOpt)[MapKind::Volume] == 0);
+}
+
+TEST_CASE("media photons: a scene without media reports no volume map, whatever --volume-photons says") {
+  const std::string dir = test::makeTempDir();
+  test::writeFile(dir + "/s.json", R"({"camera": {"position": [0, 1, 4], "target": [0, 0.5, 0], "resolution": [8, 6]},
+    "materials": {"glass": {"type": "dielectric", "ior": 1.5}},
+    "objects": [{"shape": {"type": "quad", "size": [4, 4]}}, {"shape": {"type": "sphere", "radius": 0.3},
+                 "material": "glass", "transform": {"translate": [0, 0.6, 0]}}],
+    "lights": [{"type": "point", "position": [0, 2, 0], "power": [50, 50, 50]}]})");
+  for (const std::string extra : {"", " --volume-photons 5000"}) {
+    test::CommandResult r = test::runTdpm("render '" + dir + "/s.json' -m time --photons 2000 --global-photons 1000 -q "
+                                          "--stats -t 1 --spp 1 -o '" + dir + "/o.exr'" + extra);
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    CHECK(r.output.find("caustic photons:") != std::string::npos);
+    CHECK(r.output.find("global photons:") != std::string::npos);
+    CHECK(r.output.find("volume") == std::string::npos);
+  }
 }
