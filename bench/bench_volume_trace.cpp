@@ -4,7 +4,8 @@
 // built over it (Kind::Time, ks 64), and, for the ratio, the global map of
 // the same scene (whose paths walk the same fog) and of the scene without
 // its fog. Counters: stored photons per second of tracing (stored_per_s),
-// emitted paths per second (paths_per_s), bytes per volume photon.
+// emitted paths per second (paths_per_s), bytes per volume photon, and the
+// volume map's trace and beam-build seconds per run (trace_s, build_s).
 // Threads: TBB's default (run with taskset or -t via the environment to pin).
 #include <benchmark/benchmark.h>
 
@@ -12,6 +13,7 @@
 #include <string>
 
 #include "core/progress.h"
+#include "core/timer.h"
 #include "photon/tracer.h"
 #include "photon/volume_beam_map.h"
 #include "scene/parse.h"
@@ -41,7 +43,7 @@ void BM_FogBallTrace(benchmark::State& state) {
   ts.storedWanted = 100000;
   ts.maxBounces = 8;
   ts.seed = 1;
-  double traceSeconds = 0, stored = 0, emitted = 0, bytes = 0;
+  double traceSeconds = 0, buildSeconds = 0, stored = 0, emitted = 0, bytes = 0;
   for (auto _ : state) {
     photon::TraceResult r = photon::tracePhotons(*s, ts, Progress{});
     traceSeconds += r.seconds;
@@ -51,14 +53,20 @@ void BM_FogBallTrace(benchmark::State& state) {
       photon::BeamBuildOptions bo;
       bo.kind = photon::BeamBuildOptions::Kind::Time;
       bo.ks = 64;
+      Timer t;
       photon::VolumeBeamMap m = photon::VolumeBeamMap::build(r.store, bo);
+      buildSeconds += t.seconds();
       bytes = m.bytesPerPhoton();
       benchmark::DoNotOptimize(m.size());
     }
   }
   state.counters["stored_per_s"] = stored / traceSeconds;
   state.counters["paths_per_s"] = emitted / traceSeconds;
-  if (kind == 0) state.counters["bytes_per_photon"] = bytes;
+  if (kind == 0) {
+    state.counters["bytes_per_photon"] = bytes;
+    state.counters["build_s"] = buildSeconds / double(state.iterations());
+    state.counters["trace_s"] = traceSeconds / double(state.iterations());
+  }
 }
 BENCHMARK(BM_FogBallTrace)->Arg(0)->Arg(1)->Arg(2)->ArgName("map")->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
 
