@@ -173,6 +173,18 @@ photon::BeamBuildOptions volumePassBeam(const ProgressiveMapPilot& pilot, const 
   return b;
 }
 
+// Pass 0: the volume pilot into the state, then pass 0's map rebuilt with
+// its own fixed kernel, as every later pass's. Returns the rebuild's seconds.
+double takeVolumePilot(ProgressiveState& state, PhotonMap& volume, const Scene& scene, const RenderOptions& opt,
+                       int pass, bool timeDependent) {
+  ProgressiveMapPilot& pilot = state.pilot.maps[MapKind::Volume];
+  storeKernel(pilot, volumePilotKernel(volume, scene, opt, timeDependent));
+  if (volume.beams.size() == 0) return 0.0;
+  Timer rebuild;
+  volume.beams = photon::VolumeBeamMap::build(volume.store, volumePassBeam(pilot, scene, opt, pass, timeDependent));
+  return rebuild.seconds();
+}
+
 template <class Integrator>
 struct Scratch {
   typename Integrator::ThreadState state;
@@ -372,14 +384,7 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
   if (!state.pilot.done) {
     for (MapKind kind : kAllMapKinds)
       if (kind != MapKind::Volume) storeKernel(state.pilot.maps[kind], pilotKernel(maps[kind], scene, opt, timeDependent));
-    PhotonMap& volume = *maps.maps[MapKind::Volume];
-    storeKernel(state.pilot.maps[MapKind::Volume], volumePilotKernel(volume, scene, opt, timeDependent));
-    if (volume.beams.size() > 0) {  // pass 0's own fixed kernel, as every later pass's
-      Timer rebuild;
-      volume.beams = photon::VolumeBeamMap::build(
-          volume.store, volumePassBeam(state.pilot.maps[MapKind::Volume], scene, opt, pass, timeDependent));
-      photonSeconds += rebuild.seconds();
-    }
+    photonSeconds += takeVolumePilot(state, *maps.maps[MapKind::Volume], scene, opt, pass, timeDependent);
     state.pilot.done = true;
     if (afterPilot) afterPilot();
   }
