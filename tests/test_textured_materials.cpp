@@ -321,7 +321,7 @@ TEST_CASE("textured eta, k, amount: bad input gets located errors") {
   CHECK(contains(pbrtError(R"(Material "coatedconductor" "texture conductor.k" "amt")"),
                  "texture \"amt\" is a float texture, but a conductor's k needs a spectrum one"));
   CHECK(contains(pbrtError(R"(Material "mix" "string materials" ["red" "blue"] "texture amount" "kd")"),
-                 "texture \"kd\" is a spectrum texture, but a mix's amount needs a float one"));
+                 "a spectrum (RGB) amount blends the two BSDFs per channel"));
   CHECK(contains(pbrtError(R"(Material "translucent" "texture reflect" "amt")"),
                  "texture \"amt\" is a float texture, but a reflectance needs a spectrum one"));
   std::filesystem::remove_all(dir);

@@ -174,6 +174,7 @@ class Importer {
   scene::TexInput texInput(const ParamSet& ps, const std::string& name, bool isFloat, Rgb fallback,
                            const std::string& what) const;
   void imageTexture(scene::TextureDef& t, const ParamSet& ps, const Loc& at, const std::string& what);
+  void shadingNormalParams(const ParamSet& ps, const Loc& at, const std::string& label, scene::MaterialDesc& m);
   // A reflectance that may be any spectrum texture: sets *index (a texture
   // that varies; the value returned is then a placeholder) or returns the value.
   Rgb textureParam(const ParamSet& ps, const std::string& name, Rgb fallback, int32_t* index) const;

@@ -88,6 +88,39 @@ scene::TexInput Importer::texInput(const ParamSet& ps, const std::string& name, 
   return in;
 }
 
+// pbrt-v3's "float bumpmap" and pbrt-v4's "float displacement" (a float
+// texture: the surface displaced along its normal, JSON "bump"), pbrt-v4's
+// "string normalmap" (an image read as linear RGB, as pbrt-v4 reads it;
+// JSON "normal_map"). A constant displacement moves the whole surface and
+// leaves its normal as it is, in pbrt too: nothing to map.
+void Importer::shadingNormalParams(const ParamSet& ps, const Loc& at, const std::string& label,
+                                   scene::MaterialDesc& m) {
+  for (const char* key : {"bumpmap", "displacement"}) {
+    if (!ps.has(key)) continue;
+    int32_t t = varyingTexture(ps, key, true, "a bump map");
+    if (t >= 0) m.bumpTexture = t;
+    else (void)floatParam(ps, key, 0);
+  }
+  if (!ps.has("normalmap")) return;
+  std::string file = ps.getString("normalmap", "");
+  if (file.empty()) failAt(at, label + ": \"string normalmap\" must name an image file");
+  m.normalMapFile = resolvePath(file, at.file, mainDir);
+  image::TexelEncoding linear;
+  linear.kind = image::TexelEncoding::Kind::Linear;
+  auto key = std::make_pair(m.normalMapFile, image::encodingName(linear));
+  auto& img = textureImages_[key];
+  if (!img) {
+    try {
+      img = std::make_shared<const image::ImageRgb>(image::readTextureImage(m.normalMapFile, linear));
+    } catch (const Error& e) {
+      textureImages_.erase(key);
+      failAt(at, label + ": normalmap: " + e.what());
+    }
+    result.inputFiles.push_back(m.normalMapFile);
+  }
+  m.normalMap = img;
+}
+
 // pbrt's imagemap: the file, its encoding, wrap, filter, scale and invert.
 void Importer::imageTexture(scene::TextureDef& t, const ParamSet& ps, const Loc& at, const std::string& what) {
   t.kind = scene::TextureDef::Kind::Image;
@@ -442,6 +475,12 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     m.type = T::Mix;
     // pbrt-v4's amount is a FloatTexture: per hit (Scene::materialAt); a
     // value outside [0, 1] there picks one component, as in pbrt.
+    if (const Param* a = ps.find("amount"); a && a->type == "texture" && a->strings.size() == 1) {
+      auto it = textures_.find(a->strings[0]);
+      if (it != textures_.end() && !it->second.isFloat && !it->second.constant)
+        ps.fail(*a, "a spectrum (RGB) amount blends the two BSDFs per channel (pbrt-v3), which tdpm's mix, one of "
+                    "the two materials per hit, cannot do; a float texture is supported");
+    }
     m.amountTexture = varyingTexture(ps, "amount", true, "a mix's amount");
     if (m.amountTexture < 0) m.amount = float(floatParam(ps, "amount", 0.5));
     if (!(m.amount >= 0 && m.amount <= 1)) failAt(at, label + ": amount must be in [0, 1]");
@@ -451,6 +490,7 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
   } else {
     failAt(at, "material type \"" + type + "\" is not supported (see docs/pbrt-import.md)");
   }
+  if (!slot.interface && m.type != T::Mix) shadingNormalParams(ps, at, label, m);
   ps.markUsed("type");
   ps.checkAllUsed();
   m.name = name;  // unique names are given when a shape first uses the material

@@ -88,6 +88,8 @@ void Importer::validateAsJson() {
   auto absolute = [](const std::string& f) { return std::filesystem::absolute(f).lexically_normal().string(); };
   for (const scene::TextureDef& t : sc.textures)
     if (t.image) decoded[{absolute(t.file), image::encodingName(t.encoding)}] = t.image;
+  for (const scene::MaterialDesc& m : sc.materials)
+    if (m.normalMap) decoded[{absolute(m.normalMapFile), "linear"}] = m.normalMap;
   for (const scene::LightDesc& l : sc.lights)
     if (l.map) decoded[{absolute(l.mapFile), l.equalArea ? "environment equal-area" : "environment latlong"}] = l.map;
   scene::ImageSource images = [&](const std::string& file, const std::string& key) -> std::shared_ptr<const image::ImageRgb> {

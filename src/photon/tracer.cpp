@@ -225,6 +225,65 @@ bool discTowardTargets(Vec3f d, Rgb e, const std::vector<Target>& targets, const
   return true;
 }
 
+// The cap of a sphere light (centre c, radius R) whose points can send
+// light into target t: a point q = c + R w faces some point of the target
+// iff dot(w, t.centre - c) > R - t.radius. Returns the cap's cosine bound
+// about its axis (-1: the whole sphere; >= 1: no point can).
+float sphereCap(const Target& t, Vec3f c, float R, Vec3f* axis) {
+  Vec3f to = t.centre - c;
+  float D = length(to);
+  *axis = D > 0 ? to / D : Vec3f(0, 0, 1);
+  if (!(D > 0)) return t.radius > R ? -1.0f : 1.0f;
+  return std::clamp((R - t.radius) / D, -1.0f, 1.0f);
+}
+
+// Caustic photons of a one-sided sphere light: the point uniform on the
+// cap that can see a target (the target chosen by its cap's area), then the
+// direction toward the targets from there; density of the point: the
+// mixture over every cap holding it. Points from which no target can be
+// reached are never drawn: uniform points on the whole sphere put half the
+// paths on its far side, each then refused for leaving the sphere inward.
+bool sphereTowardTargets(const Light& light, const AreaLightFrame& fr, const std::vector<Target>& targets,
+                         Vec2f uPos, Vec3f uvw, EmittedRay& out) {
+  const float R = fr.radius;
+  float total = 0;
+  Vec3f axis;
+  for (const Target& t : targets) {
+    float k = sphereCap(t, fr.center, R, &axis);
+    if (k < 1.0f) total += 1.0f - k;
+  }
+  if (!(total > 0)) return false;
+  float pick = uPos.x * total, acc = 0, k = 1.0f, w0 = 0;
+  for (const Target& t : targets) {
+    float kt = sphereCap(t, fr.center, R, &axis);
+    if (kt >= 1.0f) continue;
+    w0 = acc;
+    acc += 1.0f - kt;
+    k = kt;
+    if (pick < acc) break;
+  }
+  float ux = std::clamp((pick - w0) / (1.0f - k), 0.0f, 0.99999994f);
+  float cosT = 1.0f - ux * (1.0f - k), sinT = std::sqrt(std::max(0.0f, 1.0f - cosT * cosT));
+  float phi = 2.0f * kPi * uPos.y;
+  Vec3f w = Frame(axis).toWorld({sinT * std::cos(phi), sinT * std::sin(phi), cosT});
+  // Density per area: each cap is chosen with probability (1 - k) / total
+  // and covers the fraction (1 - k) / 2 of the area: 2 / (A total) per cap.
+  int covering = 0;
+  for (const Target& t : targets) {
+    Vec3f a;
+    float kt = sphereCap(t, fr.center, R, &a);
+    covering += kt < 1.0f && dot(w, a) >= kt;
+  }
+  float pdfArea = float(std::max(covering, 1)) * 2.0f / (fr.area * total);
+  Vec3f q = fr.center + w * R;
+  float pdf = sampleTowardTargets(targets, q, EmitterCone{}, uvw, out.direction);
+  float cosE = dot(out.direction, w);
+  if (!(pdf > 0) || cosE <= 0) return false;
+  out.origin = q;
+  out.flux = areaLightRadiance(light, fr, w, out.direction) * (cosE / (pdfArea * pdf));
+  return true;
+}
+
 // Caustic-map emission of one light toward the targets. flux = emitted
 // radiometric quantity / density, as in emitFromLight.
 template <class Stream>
@@ -253,6 +312,8 @@ bool emitTowardTargets(const Light& light, const std::vector<Target>& targets, f
     case Light::Type::Area: {
       AreaLightFrame fr = areaLightFrame(light, time01);
       if (!(fr.area > 0)) return false;
+      if (light.shape == Light::AreaShape::Sphere && !light.twoSided && !light.reversed)
+        return sphereTowardTargets(light, fr, targets, rng.get2D(dims::kPhotonPosition), uvw, out);
       // x and y crossed: the old expression drew its two rng.uniform()
       // calls right to left (GCC's order), and random keeps its maps.
       Vec2f uPos = rng.get2D(dims::kPhotonPosition);
@@ -470,7 +531,7 @@ struct Tracer {
         if (settings.kind == MapKind::Caustic && !glossyBounce) return rays;  // L (S|G)+ D ends here
       }
       std::optional<Material> textured;
-      ShadingContext ctx = makeShadingContext(scene.shadedMaterial(mat, hit, textured), scene.albedoAt(mat, hit), hit.n, -dir);
+      ShadingContext ctx = scene.shadingContext(mat, hit, -dir, textured);
       BsdfSample bs;
       Vec3f ub = rng.get3D(dims::vertexGroup(bounce, dims::kBsdf));
       if (!bsdfSample(ctx, {ub.x, ub.y}, ub.z, Transport::Importance, bs)) return rays;

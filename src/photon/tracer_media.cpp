@@ -90,7 +90,7 @@ uint64_t walkPhotonInMedia(const Scene& scene, const TraceSettings& settings, co
       if (caustic && !glossyBounce) return rays;  // L (S|G)+ D ends here
     }
     std::optional<Material> textured;
-    ShadingContext ctx = makeShadingContext(scene.shadedMaterial(mat, hit, textured), scene.albedoAt(mat, hit), hit.n, -dir);
+    ShadingContext ctx = scene.shadingContext(mat, hit, -dir, textured);
     BsdfSample bs;
     Vec3f ub = rng.get3D(dims::vertexGroup(bounce, dims::kBsdf));
     if (!bsdfSample(ctx, {ub.x, ub.y}, ub.z, Transport::Importance, bs)) return rays;

@@ -71,7 +71,7 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
     if (depth == lastDepth) break;
     const Material& mat = scene_.materialAt(hit, -dir);
     std::optional<Material> textured;
-    ShadingContext ctx = makeShadingContext(scene_.shadedMaterial(mat, hit, textured), scene_.albedoAt(mat, hit), hit.n, -dir);
+    ShadingContext ctx = scene_.shadingContext(mat, hit, -dir, textured);
 
     // Guide cones at the first two diffuse vertices: not only a caustic
     // seen directly (or in a mirror), but also one lighting what is seen,

@@ -247,7 +247,7 @@ Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, flo
       }
       const Material& m = scene_.materialAt(h, -d);
       std::optional<Material> textured;
-      ShadingContext c = makeShadingContext(scene_.shadedMaterial(m, h, textured), scene_.albedoAt(m, h), h.n, -d);
+      ShadingContext c = scene_.shadingContext(m, h, -d, textured);
       // Through mirrors, glass and sharp metals to the first diffuse-like
       // surface: light a sharp metal reflects toward the gather point is in
       // the caustic map (L (S|G)+ D, Material::isGlossy), and light reaching
@@ -357,7 +357,7 @@ Rgb PhotonIntegrator::traceFrom(Vec3f origin, Vec3f dir, float time01, EyeVertex
     }
     const Material& mat = scene_.materialAt(hit, -dir);
     std::optional<Material> textured;
-    ShadingContext ctx = makeShadingContext(scene_.shadedMaterial(mat, hit, textured), scene_.albedoAt(mat, hit), hit.n, -dir);
+    ShadingContext ctx = scene_.shadingContext(mat, hit, -dir, textured);
     bool timeDependent = s_.timeDependent && touched;
     float minVolume = s_.footprintVolume * pathLength * pathLength;
 

@@ -199,7 +199,7 @@ Rgb PathTracer::traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& sample
     if (depth == lastDepth) break;
     const Material& mat = scene_.materialAt(hit, -dir);
     std::optional<Material> textured;
-    ShadingContext ctx = makeShadingContext(scene_.shadedMaterial(mat, hit, textured), scene_.albedoAt(mat, hit), hit.n, -dir);
+    ShadingContext ctx = scene_.shadingContext(mat, hit, -dir, textured);
     if (directOnly_ && !mat.isDeltaOnly()) lastDepth = std::min(lastDepth, depth + 1);
     if (!mat.isDeltaOnly()) {
       Scatterer sc{&ctx, -dir, 0.0f};

@@ -75,9 +75,21 @@ ShadingContext makeShadingContext(const Material& m, Rgb albedo, Vec3f outwardNo
   return c;
 }
 
+ShadingContext makeShadingContext(const Material& m, Rgb albedo, Vec3f outwardNormal, Vec3f woWorld, Vec3f ns) {
+  float wg = dot(woWorld, outwardNormal), ws = dot(woWorld, ns);
+  if ((wg > 0) != (ws > 0) || ws == 0.0f) return makeShadingContext(m, albedo, outwardNormal, woWorld);
+  bool flip = !m.transmits() && wg < 0;
+  ShadingContext c{&m, albedo, Frame(flip ? -ns : ns), {}};
+  c.woLocal = c.frame.toLocal(woWorld);
+  c.shaded = true;
+  c.ng = flip ? -outwardNormal : outwardNormal;
+  return c;
+}
+
 Rgb bsdfEval(const ShadingContext& c, Vec3f wiWorld) {
   Vec3f wo = c.woLocal, wi = c.frame.toLocal(wiWorld);
   const Material& m = *c.material;
+  if (c.shaded && !c.sidesAgree(wiWorld)) return Rgb(0.0f);
   if (m.type >= Material::Type::Conductor) return pbrtBsdfEval(c, wo, wi);  // pbrt's materials: bsdf_pbrt.cpp
   if (wo.z <= 0 || wi.z <= 0) return Rgb(0.0f);
   switch (m.type) {
@@ -101,6 +113,7 @@ Rgb bsdfEval(const ShadingContext& c, Vec3f wiWorld) {
 float bsdfPdf(const ShadingContext& c, Vec3f wiWorld) {
   Vec3f wo = c.woLocal, wi = c.frame.toLocal(wiWorld);
   const Material& m = *c.material;
+  if (c.shaded && !c.sidesAgree(wiWorld)) return 0.0f;
   if (m.type >= Material::Type::Conductor) return pbrtBsdfPdf(c, wo, wi);
   if (wo.z <= 0 || wi.z <= 0) return 0.0f;
   switch (m.type) {
@@ -120,12 +133,19 @@ float dielectricBranches(const ShadingContext& c, Transport mode, BsdfSample& re
   Vec3f wo = c.woLocal;
   float eta = wo.z > 0 ? m.ior : 1.0f / m.ior;
   float F = fresnelDielectric(std::fabs(wo.z), eta);
-  bsdfSample(c, {0, 0}, 0.0f, mode, reflected);
-  bsdfSample(c, {0, 0}, std::nextafter(1.0f, 0.0f), mode, refracted);
+  // A branch the shading normal turns to the wrong geometric side carries nothing (bsdf.h).
+  if (!bsdfSample(c, {0, 0}, 0.0f, mode, reflected)) reflected.weight = Rgb(0.0f);
+  if (!bsdfSample(c, {0, 0}, std::nextafter(1.0f, 0.0f), mode, refracted)) refracted.weight = Rgb(0.0f);
   return F;
 }
 
 bool bsdfSample(const ShadingContext& c, Vec2f u, float uLobe, Transport mode, BsdfSample& out) {
+  if (c.shaded) {
+    // As below, then the shading and geometric normals must agree (bsdf.h).
+    ShadingContext plain = c;
+    plain.shaded = false;
+    return bsdfSample(plain, u, uLobe, mode, out) && c.sidesAgree(out.wi);
+  }
   const Material& m = *c.material;
   Vec3f wo = c.woLocal;
   switch (m.type) {

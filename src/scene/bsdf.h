@@ -20,13 +20,30 @@ enum class Transport : uint8_t { Radiance, Importance };
 struct ShadingContext {
   const Material* material;
   Rgb albedo;   // texture evaluated at the hit
-  Frame frame;  // world <-> local
+  Frame frame;  // world <-> local (z: the shading normal)
   Vec3f woLocal;
+  // A shading normal (bump / normal map) made the frame: ng is the
+  // geometric normal on the frame's side, and a direction scatters only
+  // when both normals agree on whether it is a reflection or a
+  // transmission (pbrt-v3's BSDF::f rule), so a bumped surface never lets
+  // light through from behind it nor reflects into itself.
+  bool shaded = false;
+  Vec3f ng{0.0f, 0.0f, 1.0f};
+  bool sidesAgree(Vec3f wiWorld) const {
+    return ((dot(woWorld(), ng) > 0) == (dot(wiWorld, ng) > 0)) == ((woLocal.z > 0) == (dot(wiWorld, frame.n) > 0));
+  }
+  Vec3f woWorld() const { return frame.toWorld(woLocal); }
 };
 
 // Builds the context at a hit: flips the frame toward wo unless the
 // material transmits.
 ShadingContext makeShadingContext(const Material& m, Rgb albedo, Vec3f outwardNormal, Vec3f woWorld);
+// The same about a shading normal ns (unit, on outwardNormal's side):
+// flipped with the geometric normal toward wo unless the material
+// transmits. When wo is on the other side of ns than of the geometric
+// normal (a grazing view of a steep bump), the geometric frame is used:
+// the BSDFs see wo below their surface there and would give black.
+ShadingContext makeShadingContext(const Material& m, Rgb albedo, Vec3f outwardNormal, Vec3f woWorld, Vec3f ns);
 
 struct BsdfSample {
   Vec3f wi;        // world

@@ -119,6 +119,8 @@ Material toMaterial(const scene::MaterialDesc& d) {
   m.kTexture = d.kTexture;
   m.amountTexture = d.amountTexture;
   m.iorTexture = d.iorTexture;
+  m.bumpTexture = d.bumpTexture;
+  m.bumpScale = d.bumpScale;
   using R = scene::MaterialDesc::Remap;
   m.roughnessRemap = d.roughnessRemap == R::PbrtV3   ? RoughnessRemap::PbrtV3
                      : d.roughnessRemap == R::PbrtV4 ? RoughnessRemap::PbrtV4
@@ -274,6 +276,41 @@ void prepareEmitter(Light& l, const scene::LightDesc& d) {
 
 TexNodeInput toInput(const scene::TexInput& in) { return {in.texture, in.value}; }
 
+// pbrt's Triangle dp/du, dp/dv (object space) from each triangle's (u, v):
+// its corners', or pbrt's default (0, 0), (1, 0), (1, 1); a degenerate uv
+// mapping gets a frame about the face normal instead.
+void triangleTangents(const TriangleMesh& mesh, SceneObject& o) {
+  const bool corners = o.uvs.size() == mesh.indices.size();  // o.uvs: the mesh's, moved there
+  const Vec2f fallback[3] = {{0, 0}, {1, 0}, {1, 1}};
+  o.dpdu.reserve(mesh.indices.size() / 3);
+  o.dpdv.reserve(mesh.indices.size() / 3);
+  for (size_t i = 0; i < mesh.indices.size(); i += 3) {
+    Vec3f p0 = mesh.vertices[mesh.indices[i]], p1 = mesh.vertices[mesh.indices[i + 1]],
+          p2 = mesh.vertices[mesh.indices[i + 2]];
+    const Vec2f* uv = corners ? &o.uvs[i] : fallback;
+    Vec2f duv02{uv[0].x - uv[2].x, uv[0].y - uv[2].y}, duv12{uv[1].x - uv[2].x, uv[1].y - uv[2].y};
+    Vec3f dp02 = p0 - p2, dp12 = p1 - p2;
+    float det = duv02.x * duv12.y - duv02.y * duv12.x;
+    Vec3f du, dv;
+    bool ok = std::fabs(det) >= 1e-9f;
+    if (ok) {
+      float inv = 1.0f / det;
+      du = (dp02 * duv12.y - dp12 * duv02.y) * inv;
+      dv = (dp12 * duv02.x - dp02 * duv12.x) * inv;
+      ok = length(cross(du, dv)) > 0 && std::isfinite(du.x + du.y + du.z + dv.x + dv.y + dv.z);
+    }
+    if (!ok) {
+      Vec3f n = cross(p1 - p0, p2 - p0);
+      float l = length(n);
+      Frame f(l > 0 ? n / l : Vec3f(0, 1, 0));
+      du = f.s;
+      dv = f.t;
+    }
+    o.dpdu.push_back(du);
+    o.dpdv.push_back(dv);
+  }
+}
+
 // desc.textures -> flat nodes (same indices) and each image's texels once.
 TextureSet toTextures(const std::vector<scene::TextureDef>& defs) {
   using K = scene::TextureDef::Kind;
@@ -405,6 +442,21 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
     if (m.roughnessTexture >= 0 || m.baseRoughnessTexture >= 0) classifyTexturedRoughness(s.materials.back(), m, s.textures);
     if (m.iorTexture >= 0) checkTexturedIor(m, s.textures);
   }
+  // Normal maps: their texels join the texture images (one copy per file).
+  bool shadingNormals = false;
+  std::map<const image::ImageRgb*, int32_t> normalMaps;
+  for (size_t i = 0; i < desc.materials.size(); ++i) {
+    const scene::MaterialDesc& d = desc.materials[i];
+    if (d.normalMap) {
+      auto [it, added] = normalMaps.try_emplace(d.normalMap.get(), int32_t(s.textures.images.size()));
+      if (added) {
+        s.textures.images.push_back({d.normalMap->width, d.normalMap->height, s.textures.texels.size()});
+        s.textures.texels.insert(s.textures.texels.end(), d.normalMap->pixels.begin(), d.normalMap->pixels.end());
+      }
+      s.materials[i].normalMapImage = it->second;
+    }
+    shadingNormals = shadingNormals || s.materials[i].hasShadingNormal();
+  }
   std::vector<uint8_t> mixState(s.materials.size(), 0);
   for (size_t i = 0; i < s.materials.size(); ++i)
     if (s.materials[i].type == Material::Type::Mix) classifyMix(s.materials, desc.materials, i, mixState);
@@ -460,6 +512,7 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
       }
       for (Vec3f v : mesh.vertices) o.objectBounds.extend(v);
       if (mesh.uvs.size() == mesh.indices.size()) o.uvs = std::move(mesh.uvs);
+      if (shadingNormals) triangleTangents(mesh, o);
       o.faceNormals.reserve(mesh.indices.size() / 3);
       for (size_t i = 0; i < mesh.indices.size(); i += 3) {
         Vec3f a = mesh.vertices[mesh.indices[i]], b = mesh.vertices[mesh.indices[i + 1]],

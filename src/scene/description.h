@@ -162,6 +162,14 @@ struct MaterialDesc {
   int32_t iorTexture = -1;     // dielectric (rough or not), uber: a float texture for ior when >= 0
   enum class Remap { None, PbrtV3, PbrtV4 };
   Remap roughnessRemap = Remap::None;
+  // Any material but mix and interface: a float texture (index into
+  // SceneDescription::textures) displacing the surface by bumpScale x its
+  // value when >= 0 (JSON "bump"), and / or a tangent-space normal map read
+  // as linear RGB (JSON "normal_map"; pbrt-v4's normalmap wins over a bump).
+  int32_t bumpTexture = -1;
+  float bumpScale = 1.0f;
+  std::string normalMapFile;
+  std::shared_ptr<const image::ImageRgb> normalMap;
 };
 
 struct ShapeDesc {

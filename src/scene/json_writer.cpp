@@ -153,7 +153,7 @@ Json namedTexture(const scene::TextureDef& t, const std::vector<scene::TextureDe
 }
 
 Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDesc>& materials,
-              const std::vector<std::string>& textures) {
+              const std::vector<std::string>& textures, const std::filesystem::path& jp) {
   using T = scene::MaterialDesc::Type;
   Json j;
   auto albedo = [&]() {
@@ -231,6 +231,12 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
       j["amount"] = m.amountTexture >= 0 ? Json(textures.at(size_t(m.amountTexture))) : Json(num(m.amount));
       break;
   }
+  // Shading normals (parse.cpp readShadingNormal).
+  if (m.bumpTexture >= 0) {
+    if (m.bumpScale == 1.0f) j["bump"] = textures.at(size_t(m.bumpTexture));
+    else j["bump"] = Json{{"texture", textures.at(size_t(m.bumpTexture))}, {"scale", num(m.bumpScale)}};
+  }
+  if (!m.normalMapFile.empty()) j["normal_map"] = relativeToJson(m.normalMapFile, jp);
   return j;
 }
 
@@ -399,7 +405,7 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
   Json materials = Json::object();
   for (const auto& m : sc.materials) {
     if (materials.contains(m.name)) throw Error(jsonPath + ": two materials are named \"" + m.name + "\"");
-    materials[m.name] = material(m, sc.materials, texNames);
+    materials[m.name] = material(m, sc.materials, texNames, jp);
   }
   root["materials"] = materials;
   Json objects = Json::array();

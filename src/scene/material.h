@@ -94,6 +94,15 @@ struct Material {
   // build.cpp refuses a texture whose range reaches below 1.
   int32_t iorTexture = -1;
   RoughnessRemap roughnessRemap = RoughnessRemap::None;
+  // Shading normals (scene/shading_normal.cpp): >= 0, a float node of
+  // Scene::textures displacing the surface along its normal by bumpScale x
+  // its value (pbrt's bump map), or an image of Scene::textures holding a
+  // tangent-space normal map (pbrt-v4's normalmap; the map wins when both
+  // are given, as in pbrt-v4). Neither: the geometric normal, as always.
+  int32_t bumpTexture = -1;
+  float bumpScale = 1.0f;
+  int32_t normalMapImage = -1;
+  bool hasShadingNormal() const { return bumpTexture >= 0 || normalMapImage >= 0; }
 
   // Purely delta (mirror, glass, smooth conductor): no photon is stored
   // here, no light sampling.

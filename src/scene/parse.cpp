@@ -675,9 +675,46 @@ const std::vector<MaterialKind>& materialKinds() {
   return kinds;
 }
 
+// A material's "bump": a float texture's name, or {"texture": name,
+// "scale": s} (the displacement is s x the texture); "normal_map": an image
+// file (resolved against the scene's folder), read as linear RGB as
+// pbrt-v4 reads normal maps, whatever its bit depth.
+void readShadingNormal(const Node& n, MaterialDesc* m, TextureReader* textures, const std::string& sceneDir) {
+  if (n.has("bump")) {
+    Node b = n.member("bump");
+    if (b.json().is_string()) {
+      m->bumpTexture = namedTextureIndex(b, textures, true);
+    } else {
+      b.requireObject();
+      b.expectObject({"texture", "scale"});
+      m->bumpTexture = namedTextureIndex(b.required("texture"), textures, true);
+      if (b.has("scale")) {
+        m->bumpScale = b.member("scale").number();
+        b.member("scale").require(std::isfinite(m->bumpScale), "scale must be finite");
+      }
+    }
+  }
+  if (n.has("normal_map")) {
+    Node f = n.member("normal_map");
+    std::string file = f.string();
+    f.require(!file.empty(), "normal_map file name must not be empty");
+    m->normalMapFile = resolveMeshPath(file, sceneDir);
+    image::TexelEncoding linear;
+    linear.kind = image::TexelEncoding::Kind::Linear;
+    m->normalMap = lentImage(m->normalMapFile, image::encodingName(linear));
+    if (!m->normalMap) {
+      try {
+        m->normalMap = std::make_shared<const image::ImageRgb>(image::readTextureImage(m->normalMapFile, linear));
+      } catch (const Error& e) {
+        f.fail(e.what());
+      }
+    }
+  }
+}
+
 // mixNames: a mix's two component names, resolved by readMaterials.
 MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader* textures,
-                          std::vector<std::string>* mixNames) {
+                          std::vector<std::string>* mixNames, const std::string& sceneDir) {
   using T = MaterialDesc::Type;
   n.requireObject();
   std::vector<std::string> names;
@@ -685,7 +722,9 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader*
   std::string typeName = n.required("type").choice(names, "material type");
   const MaterialKind& kind = *std::find_if(materialKinds().begin(), materialKinds().end(),
                                            [&](const MaterialKind& k) { return typeName == k.name; });
-  n.expectObject(kind.keys);
+  std::vector<std::string> keys = kind.keys;
+  if (kind.type != T::Mix && kind.type != T::Interface) keys.insert(keys.end(), {"bump", "normal_map"});
+  n.expectObject(keys);
   MaterialDesc m;
   m.name = name;
   m.type = kind.type;
@@ -759,6 +798,7 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader*
     m.thickness = n.member("thickness").number();
     n.member("thickness").require(m.thickness >= 0 && std::isfinite(m.thickness), "thickness must be non-negative, got " + fmt(m.thickness));
   }
+  readShadingNormal(n, &m, textures, sceneDir);
   return m;
 }
 
@@ -766,14 +806,14 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader*
 // no-surface material, only a boundary between media.
 constexpr const char* kInterfaceMaterial = "interface";
 
-std::vector<MaterialDesc> readMaterials(const Node& n, TextureReader* textures) {
+std::vector<MaterialDesc> readMaterials(const Node& n, TextureReader* textures, const std::string& sceneDir) {
   std::vector<MaterialDesc> out;
   std::vector<std::pair<size_t, std::vector<std::string>>> mixes;
   std::vector<Node> nodes;
   n.forEachMember([&](const std::string& name, const Node& m) {
     m.require(!name.empty(), "material names must not be empty");
     std::vector<std::string> mixNames;
-    out.push_back(readMaterial(m, name, textures, &mixNames));
+    out.push_back(readMaterial(m, name, textures, &mixNames, sceneDir));
     m.require(name != kInterfaceMaterial || out.back().type == MaterialDesc::Type::Interface,
               "the material name \"interface\" is reserved for {\"type\": \"interface\"} (no surface)");
     nodes.push_back(m);
@@ -1356,7 +1396,7 @@ SceneDescription readScene(const Node& root, const std::string& sourcePath) {
     textures.emplace(root.member("textures"), sceneDir, &scene.textures);
     textures->readAll();
   }
-  if (root.has("materials")) scene.materials = readMaterials(root.member("materials"), textures ? &*textures : nullptr);
+  if (root.has("materials")) scene.materials = readMaterials(root.member("materials"), textures ? &*textures : nullptr, sceneDir);
   Node objects = root.required("objects");
   size_t count = objects.arraySize("objects");
   for (size_t i = 0; i < count; ++i) {

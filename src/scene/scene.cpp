@@ -48,6 +48,7 @@ bool Scene::intersect(Vec3f o, Vec3f d, float tFar, float time01, Hit& hit) cons
   if (!embree_.intersect(o, d, tFar, time01, raw)) return false;
   hit.t = raw.t;
   hit.p = o + d * raw.t;
+  hit.time01 = time01;
   int32_t owner = geometryOwner_[raw.geometryId];
   if (owner < 0) {
     hit.light = -owner - 1;

@@ -12,6 +12,7 @@
 #include "math/bounds.h"
 #include "media/medium.h"
 #include "motion/motion.h"
+#include "scene/bsdf.h"
 #include "scene/camera.h"
 #include "scene/description.h"
 #include "scene/embree_scene.h"
@@ -34,6 +35,9 @@ struct SceneObject {
   Bounds3f sweptBounds;             // world, over the whole shutter
   std::vector<Vec3f> faceNormals;   // triangles: object-space unit normals
   std::vector<Vec2f> uvs;           // triangles: (u, v) per corner, or empty (pbrt's default per triangle)
+  // Triangles, only in scenes with shading normals (bump / normal maps):
+  // object-space dp/du and dp/dv per triangle (pbrt's Triangle, from uvs).
+  std::vector<Vec3f> dpdu, dpdv;
   // Static objects only (precomputed, so a hit costs no matrix inverse):
   std::vector<Vec3f> worldNormals;  // triangles: world-space unit normals
   Vec3f worldCentre;                // sphere centre
@@ -59,6 +63,7 @@ struct Hit {
   uint32_t primitive = 0;  // triangle within the object
   Vec2f bary;              // triangles: barycentrics of its vertices 1 and 2
   int32_t light = -1;  // index into lights when an area light was hit
+  float time01 = 0;    // the ray's normalised time (a moving object's tangents)
   bool isLight() const { return light >= 0; }
 };
 
@@ -92,6 +97,23 @@ class Scene {
       return m;
     return shadeTextured(m, hit, scratch);
   }
+  // The shading context at a hit on an object for the material materialAt
+  // gave (textured parameters in `scratch`, as shadedMaterial): its frame
+  // about the geometric normal, or the bumped / normal-mapped shading normal
+  // when the material has one (scene/shading_normal.cpp). Every integrator
+  // builds its contexts here, so shading normals apply everywhere.
+  ShadingContext shadingContext(const Material& m, const Hit& hit, Vec3f wo, std::optional<Material>& scratch) const {
+    if (!m.hasShadingNormal()) return makeShadingContext(shadedMaterial(m, hit, scratch), albedoAt(m, hit), hit.n, wo);
+    return makeShadingContext(shadedMaterial(m, hit, scratch), albedoAt(m, hit), hit.n, wo, shadingNormal(m, hit));
+  }
+  // The material's shading normal at the hit (unit, on hit.n's side):
+  // pbrt-v4's BumpMap (the displaced surface's dp/du x dp/dv) or NormalMap
+  // (the map's tangent-space normal in the frame of dp/du and the normal).
+  Vec3f shadingNormal(const Material& m, const Hit& hit) const;
+  // World-space dp/du, dp/dv at a hit on an object, pbrt's for each shape
+  // (triangles: from their (u, v), or a frame about the normal when those
+  // are degenerate). Triangles need the tangents built (scene with shading normals).
+  void surfaceTangents(const Hit& hit, Vec3f* dpdu, Vec3f* dpdv) const;
   // The material a hit on an object uses, seen from direction wo:
   // resolveMaterial (material.h) with each mix's amount at the hit, its
   // texture evaluated there when it has one (pbrt-v4's FloatTexture amount).
