@@ -232,6 +232,7 @@ void printAnimationSummary(const RenderArgs& a, const RenderOptions& opt, const 
     double all = allSeconds;
     std::string storedText;  // "N caustic, M global"
     for (MapKind k : kAllMapKinds)
+      if (mapKindReported(k, stats.maps[k]))
       storedText += (storedText.empty() ? "" : ", ") + std::to_string(stats.maps[k].stored) + " " + mapKindName(k);
     std::fprintf(stderr,
                  "tdpm: %s, %s: %d frames (%d-%d) at %dx%d, %.2f s in all, %.2f s per frame; photons: %s stored in "

@@ -40,6 +40,7 @@
 #include "render/progressive.h"
 #include "render/renderer.h"
 #include "render/threads.h"
+#include "scene/build_media.h"
 #include "scene/limits.h"
 #include "scene/parse.h"
 #include "scene/scene.h"
@@ -131,6 +132,7 @@ void printStats(const RenderStats& st) {
                formatMiB(st.peakResidentBytes).c_str());
   std::fprintf(stderr, "  bytes per photon: %.2f\n", st.bytesPerPhoton);
   for (MapKind k : kAllMapKinds)
+    if (mapKindReported(k, st.maps[k]))
     std::fprintf(stderr, "  %s photons: %llu stored, %llu emitted\n", mapKindName(k), u(st.maps[k].stored),
                  u(st.maps[k].emitted));
   if (st.guideStored > 0)
@@ -145,6 +147,7 @@ void printStats(const RenderStats& st) {
   std::string few;
   uint64_t knn = 0;
   for (MapKind k : kAllMapKinds) {
+    if (!mapKindReported(k, st.maps[k])) continue;
     few += std::string(few.empty() ? "" : ", ") + mapKindName(k) + " " + std::to_string(st.maps[k].fewEstimates) +
            " of " + std::to_string(st.maps[k].estimates);
     knn += st.maps[k].estimates;
@@ -238,7 +241,10 @@ void applyPhotonsPerPixel(const RenderArgs& a, const scene::SceneDescription& de
 }
 
 // Merges flags over the scene's settings over the renderer's defaults.
-RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath) {
+// `media`: the scene has participating media (scene::usesMedia), so a
+// volume map is traced; without them --volume-photons has no map to fill.
+RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc, const std::string& sourcePath,
+                           bool media) {
   RenderOptions o;
   // Both names were checked (runRender, scene/parse): this is the one parse.
   const std::string methodName = pick(a.method, sc.method, std::string(renderMethodName(o.method)));
@@ -261,6 +267,8 @@ RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc,
   o.causticGuiding = a.causticGuiding.value_or(o.causticGuiding);
   o.causticPhotons = size_t(pick(a.photons, sc.photons, int64_t(o.causticPhotons)));
   o.globalPhotons = size_t(pick(a.globalPhotons, sc.globalPhotons, int64_t(o.globalPhotons)));
+  if (media)
+    o.volumePhotons = size_t(pick(a.volumePhotons, sc.volumePhotons, int64_t(RenderOptions::kDefaultVolumePhotons)));
   o.frames = pick(a.frames, sc.frames, o.frames);
   o.spaceTime4D = pick(a.search, sc.search, std::string("twopass")) == "4d";
   o.estimate.k = pick(a.k, sc.k, o.estimate.k);
@@ -278,6 +286,7 @@ RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc,
   // For the memory-budget error: name what set each count.
   if (!a.photons && sc.photons) o.causticPhotonsSource = "render.photons in " + sourcePath;
   if (!a.globalPhotons && sc.globalPhotons) o.globalPhotonsSource = "render.global_photons in " + sourcePath;
+  if (!a.volumePhotons && sc.volumePhotons) o.volumePhotonsSource = "render.volume_photons in " + sourcePath;
   if (o.maxSpp < o.spp) {
     auto source = [&](bool flag, bool scene, const char* flagName, const char* key) {
       return flag ? std::string(flagName) : scene ? "render." + std::string(key) + " in " + sourcePath : std::string("default");
@@ -329,7 +338,7 @@ void warnAccumulationPhotons(const RenderOptions& o, bool hasMotion, const Rende
 }  // namespace
 
 RenderOptions renderOptionsFor(const RenderArgs& a, const scene::SceneDescription& desc) {
-  RenderOptions o = mergeOptions(a, desc.render, a.scene);
+  RenderOptions o = mergeOptions(a, desc.render, a.scene, scene::usesMedia(desc));
   applyPhotonsPerPixel(a, desc, {}, o);
   return o;
 }
@@ -387,6 +396,10 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_option("--photons", a.photons, "Caustic photons to store (default 200000)")
       ->check(rangeOf(limits::kPhotons))->group(photonGroup);
   c->add_option("--global-photons", a.globalPhotons, "Global photons to store (default 50000)")
+      ->check(rangeOf(limits::kPhotons))->group(photonGroup);
+  c->add_option("--volume-photons", a.volumePhotons,
+                "Volume photons to store, at scattering events in participating media (default 100000 when the scene "
+                "has media; no volume map otherwise)")
       ->check(rangeOf(limits::kPhotons))->group(photonGroup);
   c->add_option("--frames", a.frames, "accumulation: in-between frames, each with 1/N of the photons and of the samples (default 8); every "
                 "frame takes at least 1 sample per pixel and one batch of photon paths, so frames above --spp or "
@@ -516,7 +529,7 @@ void loadRenderSetup(const RenderArgs& a, dist::Comm& comm, bool framePattern, R
     for (const scene::ObjectDesc& o : s.desc.objects)
       if (o.shape.type == scene::ShapeDesc::Type::Mesh)
         refuseOverwritingInput(s.output, s.preview, o.shape.meshFile, "the mesh file of object '" + o.name + "'");
-  s.opt = mergeOptions(a, s.desc.render, a.scene);
+  s.opt = mergeOptions(a, s.desc.render, a.scene, scene::usesMedia(s.desc));
   // A pbrt scene's photon count comes from a statement, not a JSON key.
   if (!a.photons && settingSources.count("photons")) s.opt.causticPhotonsSource = settingSources["photons"];
   // Passes by default where they are available: not for an animation's frames.
@@ -618,6 +631,7 @@ void printRenderSummary(const RenderArgs& a, const RenderSetup& s, const RenderS
     if (renderMethodTraits(s.opt.method).photonMaps) {
       std::string maps;  // "N caustic (M emitted), ..." in kind order
       for (MapKind k : kAllMapKinds)
+        if (mapKindReported(k, stats.maps[k]))
         maps += (maps.empty() ? "" : ", ") + formatCount(stats.maps[k].stored) + " " + mapKindName(k) + " (" +
                 formatCount(stats.maps[k].emitted) + " emitted)";
       std::fprintf(stderr, "tdpm: photons: %s, %.1f bytes each, %.2f s; estimates: %llu time-dependent, %llu standard\n",

@@ -25,7 +25,7 @@ struct RenderArgs {
   std::optional<std::string> resolution;  // "WxH"
   std::optional<float> exposure;
   // photon methods
-  std::optional<int64_t> photons, globalPhotons;
+  std::optional<int64_t> photons, globalPhotons, volumePhotons;
   std::optional<int> frames, k, gather;
   std::optional<std::string> search, kernelSpace, kernelTime;
   std::optional<std::string> sampler, filter;

@@ -33,8 +33,8 @@ std::map<std::string, std::string> renderMetadata(const std::string& scenePath, 
     m["tdpm/caustic_guiding"] = formatG(opt.causticGuiding);
     return m;
   }
-  for (MapKind k : kAllMapKinds)  // "tdpm/caustic_photons", "tdpm/global_photons"
-    m[std::string("tdpm/") + mapKindName(k) + "_photons"] = std::to_string(st.maps[k].stored);
+  for (MapKind k : kAllMapKinds)  // "tdpm/caustic_photons", "tdpm/global_photons", "tdpm/volume_photons" (media)
+    if (mapKindInUse(opt, k)) m[std::string("tdpm/") + mapKindName(k) + "_photons"] = std::to_string(st.maps[k].stored);
   if (method.timeDependentEstimate) m["tdpm/search"] = opt.spaceTime4D ? "4d" : "twopass";
   if (method.inBetweenFrames && !opt.progressive) m["tdpm/frames"] = std::to_string(opt.frames);
   return m;

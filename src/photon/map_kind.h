@@ -7,7 +7,9 @@
 namespace tdpm::photon {
 
 // caustic: L (S|G)+ D, stored at the first diffuse-like surface after a
-// specular one; global: every diffuse-like hit (photon/tracer.h).
-enum class MapKind : uint8_t { Caustic, Global };
+// specular one; global: every diffuse-like hit; volume: every scattering
+// event in a participating medium, never at surfaces (photon/tracer.h;
+// traced only when the scene has media).
+enum class MapKind : uint8_t { Caustic, Global, Volume };
 
 }  // namespace tdpm::photon

@@ -18,6 +18,7 @@
 #include "core/timer.h"
 #include "math/frame.h"
 #include "photon/surface_tag.h"
+#include "photon/tracer_media.h"
 #include "sampling/warp.h"
 #include "scene/bsdf.h"
 
@@ -400,10 +401,10 @@ struct Tracer {
         SobolStream s{sobolSeed, uint32_t(g)};
         s.table = seedTable.data();
         s.tableSize = kSeedTableGroups;
-        rays += tracePath(time01, s, energyScale, out, exits);
+        rays += tracePath(time01, g, s, energyScale, out, exits);
       } else {
         RandomStream s{&rng};
-        rays += tracePath(time01, s, energyScale, out, exits);
+        rays += tracePath(time01, g, s, energyScale, out, exits);
       }
     }
     return rays;
@@ -414,7 +415,8 @@ struct Tracer {
   // exits (caustic maps, optional): receives each stored photon's last
   // specular vertex, in store order.
   template <class Stream>
-  uint64_t tracePath(float time01, Stream& rng, double energyScale, PhotonStore& out, std::vector<ExitPoint>* exits) const {
+  uint64_t tracePath(float time01, uint64_t pathIndex, Stream& rng, double energyScale, PhotonStore& out,
+                     std::vector<ExitPoint>* exits) const {
     uint64_t rays = 0;
     uint32_t li = lights.pick(rng.get1D(dims::kPhotonLight));
     const Light& light = scene.lights[li];
@@ -435,6 +437,12 @@ struct Tracer {
     // Off the emitter's surface: an area light is geometry, and a photon
     // starting on it would hit it at distance zero.
     Vec3f origin = scene.spawnOrigin(ray.origin, ray.direction, ray.direction), dir = ray.direction;
+    // Media: the walk of photon/tracer_media.h (a scene without media never
+    // takes it, so its paths are exactly the loop below).
+    if (scene.hasMedia()) {
+      MediaPath mp{origin, dir, power, time01, time, scene.lightMedia[li], invariant, pathIndex};
+      return rays + walkPhotonInMedia(scene, settings, mp, rng, energyScale, out, exits);
+    }
     bool allSpecular = true;  // every bounce so far was a delta reflection/refraction
     Vec3f lastSpecular = origin;
     for (int bounce = 0; bounce <= settings.maxBounces; ++bounce) {
@@ -688,7 +696,10 @@ TraceResult traceMap(const Scene& scene, const TraceSettings& settings, const Tr
   TDPM_ASSERT(settings.invariant == InvariantPhotons::All || settings.motion, "time-invariance needs the motion bounds");
   if (settings.storedWanted == 0 || tracer.lights.empty()) return result;
   if (settings.kind == MapKind::Caustic && !sceneHasSpecular(scene, settings.glossyCaustics)) return result;
-  const char* stage = settings.kind == MapKind::Caustic ? "caustic photons" : "global photons";
+  if (settings.kind == MapKind::Volume && !scene.hasMedia()) return result;  // nowhere to scatter
+  const char* stage = settings.kind == MapKind::Caustic  ? "caustic photons"
+                      : settings.kind == MapKind::Global ? "global photons"
+                                                         : "volume photons";
   const PathRange& range = extras.range;
   if (range.paths > 0) {
     // A progressive pass: the count is fixed (pass 0's pilot chose it).

@@ -3,9 +3,13 @@
 // shutter, or a fixed time for the static and accumulation methods) and is
 // traced through the scene as it is at that time; every stored photon keeps
 // it. Photons carry radiant energy Q = flux * ts / n_emitted (method.md
-// section 2). Two maps, traced separately so each gets its own budget:
+// section 2). Three maps, traced separately so each gets its own budget:
 //  * caustic: paths L S+ D, stored at the first non-delta surface;
-//  * global: every non-delta surface hit.
+//  * global: every non-delta surface hit;
+//  * volume (scenes with media): every scattering event in a medium,
+//    never at surfaces; emission unaimed.
+// In scenes with media every path walks through them (free flight,
+// interfaces, scattering): photon/tracer_media.h, where the rules are.
 // Work is split into fixed batches with their own seeds and concatenated in
 // batch order, so the maps are identical for any thread count.
 #pragma once

@@ -94,7 +94,10 @@ std::map<std::string, std::string> renderSettings(const RenderOptions& o, int wi
       {"alpha", o.alpha > 0 ? floatText(o.alpha) : "auto"},
   };
   // The photon counts, by the kinds' option names ("photons", "global_photons").
-  for (MapKind k : kAllMapKinds) s[mapKindInfo(k).optionName] = std::to_string(o.*mapKindInfo(k).photons);
+  // The volume map's only when it is traced (mapKindInUse): a scene without
+  // media keeps its fingerprint.
+  for (MapKind k : kAllMapKinds)
+    if (mapKindInUse(o, k)) s[mapKindInfo(k).optionName] = std::to_string(o.*mapKindInfo(k).photons);
   // Progressive passes' per-pixel sample counts (render/sample_allocation.h):
   // one key, present only when they are on, so that a render without them
   // keeps the fingerprint it had before they existed.

@@ -11,9 +11,11 @@ namespace {
 
 const MapKindInfo kTable[kMapKinds] = {
     {MapKind::Caustic, "caustic", "photons", &RenderOptions::causticPhotons, &RenderOptions::causticPhotonsSource,
-     false, false},
+     false, false, false},
     {MapKind::Global, "global", "global_photons", &RenderOptions::globalPhotons, &RenderOptions::globalPhotonsSource,
-     true, true},
+     true, true, false},
+    {MapKind::Volume, "volume", "volume_photons", &RenderOptions::volumePhotons, &RenderOptions::volumePhotonsSource,
+     true, false, true},
 };
 
 }  // namespace
@@ -22,6 +24,11 @@ const MapKindInfo& mapKindInfo(MapKind kind) {
   const MapKindInfo& row = kTable[size_t(kind)];
   TDPM_ASSERT(row.kind == kind, "render/map_kinds.cpp: the table is out of the enum's order");
   return row;
+}
+
+bool mapKindInUse(const RenderOptions& opt, MapKind kind) {
+  const MapKindInfo& row = mapKindInfo(kind);
+  return !row.onlyWhenAsked || opt.*row.photons > 0;
 }
 
 }  // namespace tdpm

@@ -1,5 +1,5 @@
-// render/map_kinds.h — the photon maps of a render, by kind (caustic and
-// global now; the volume map of participating media is next). PerMap<T> is
+// render/map_kinds.h — the photon maps of a render, by kind (caustic,
+// global, and the volume map of participating media). PerMap<T> is
 // one value per kind, indexed by photon::MapKind: requests, kernels,
 // statistics, memory and the maps themselves are held that way, so code
 // loops over kMapKinds instead of naming caustic and global. The one table
@@ -21,11 +21,11 @@ namespace tdpm {
 
 using photon::MapKind;
 
-inline constexpr size_t kMapKinds = 2;
+inline constexpr size_t kMapKinds = 3;
 // In the order the maps are traced (and their figures reported).
-inline constexpr std::array<MapKind, kMapKinds> kAllMapKinds = {MapKind::Caustic, MapKind::Global};
+inline constexpr std::array<MapKind, kMapKinds> kAllMapKinds = {MapKind::Caustic, MapKind::Global, MapKind::Volume};
 
-// One T per kind. An aggregate: PerMap<size_t> p = {caustic, global}.
+// One T per kind. An aggregate: PerMap<size_t> p = {caustic, global, volume}.
 template <class T>
 struct PerMap {
   std::array<T, kMapKinds> values{};
@@ -48,9 +48,17 @@ struct MapKindInfo {
   // Traced only when the render gathers from it (final gather rays, or
   // --global-direct): wantsGlobalMap in render/photon_map.h.
   bool onlyWhenGathered;
+  // Part of a render only when its count is not 0 (the volume map: the CLI
+  // asks for it only when the scene has media): otherwise its keys stay out
+  // of every report, fingerprint and state, so a scene without media keeps
+  // the --stats, --json, EXR metadata and fingerprints it had before.
+  bool onlyWhenAsked;
 };
 
 const MapKindInfo& mapKindInfo(MapKind kind);
+// Whether the kind belongs to this render at all (see onlyWhenAsked):
+// reports, fingerprints and states skip a kind that does not.
+bool mapKindInUse(const RenderOptions& opt, MapKind kind);
 inline const char* mapKindName(MapKind kind) { return mapKindInfo(kind).name; }
 
 // What one map cost and holds, summed over the maps of its kind a render
@@ -63,5 +71,11 @@ struct MapStats {
   // kernels are fixed).
   uint64_t estimates = 0, fewEstimates = 0;
 };
+
+// From figures alone (printers without the options): the kind is reported
+// unless it is onlyWhenAsked and its map neither emitted nor stored.
+inline bool mapKindReported(MapKind kind, const MapStats& st) {
+  return !mapKindInfo(kind).onlyWhenAsked || st.emitted > 0 || st.stored > 0;
+}
 
 }  // namespace tdpm

@@ -32,6 +32,11 @@ constexpr uint64_t kChunkPaths = 256 * 1024;
 constexpr uint64_t kBuild3Bytes = 16 + 5;   // kd-tree builder: 3D keys + index, then permutation + axis
 constexpr uint64_t kBuild4Bytes = 20 + 5;   // 4D keys + index, permutation + axis
 constexpr uint64_t kPilotPaths = 16 * 1024; // photon/tracer.cpp: 16 pilot batches of 1024 paths
+// The volume map (photon/volume_beam_map.h): the store and its tree (20),
+// plus radius, window and subtree-bound codes (3): bytesPerPhoton's 23.
+// Never 4D. Its build adds one float radius a photon to the 3D builder's.
+constexpr uint64_t kBeamCodeBytes = 3;
+constexpr uint64_t kBeamBuildBytes = 4;
 
 // The photon maps the options will really trace (a caustic map needs a
 // specular surface, any map needs a light; accumulation traces 1/N per
@@ -47,6 +52,7 @@ PhotonCounts photonCounts(const Scene& scene, const RenderOptions& opt) {
   if (!method.photonMaps || scene.lights.empty()) return p;
   p.stored = photonsWanted(opt);
   if (!photon::sceneHasSpecular(scene)) p.stored[MapKind::Caustic] = 0;
+  if (!scene.hasMedia()) p.stored[MapKind::Volume] = 0;
   if (method.inBetweenFrames) {
     size_t frames = size_t(scene.hasMotion ? std::max(1, opt.frames) : 1);
     for (MapKind k : kAllMapKinds) p.stored[k] = (p.stored[k] + frames - 1) / frames;
@@ -66,13 +72,18 @@ PerMap<std::string> photonSources(const RenderOptions& opt) {
 
 uint64_t photonMemoryBytes(const PerMap<size_t>& stored, bool spaceTime4D, int maxDepth) {
   // One map: what it keeps, and the most it holds at once while it is made.
-  auto kept = [&](uint64_t n) { return n * kStoreBytes * (spaceTime4D ? 2 : 1); };
-  auto peak = [&](uint64_t n, uint64_t storedPerPilotPath) {
+  auto kept = [&](MapKind k, uint64_t n) {
+    if (k == MapKind::Volume) return n * (kStoreBytes + kBeamCodeBytes);
+    return n * kStoreBytes * (spaceTime4D ? 2 : 1);
+  };
+  auto peak = [&](MapKind k, uint64_t n, uint64_t storedPerPilotPath) {
     if (n == 0) return uint64_t(0);
     uint64_t chunk = std::min<uint64_t>(n, kChunkPaths * storedPerPilotPath) * kChunkBytes;
     uint64_t tracing = n * (kStoreBytes + kShrinkBytes) + chunk;
     // 3D: store + builder. 4D: the 3D copy is kept while the 4D tree is built.
-    uint64_t building = spaceTime4D ? n * (2 * kStoreBytes + kBuild4Bytes) : n * (kStoreBytes + kBuild3Bytes);
+    uint64_t building = k == MapKind::Volume ? n * (kStoreBytes + kBuild3Bytes + kBeamCodeBytes + kBeamBuildBytes)
+                        : spaceTime4D        ? n * (2 * kStoreBytes + kBuild4Bytes)
+                                             : n * (kStoreBytes + kBuild3Bytes);
     uint64_t pilot = kPilotPaths * storedPerPilotPath * (kStoreBytes + kChunkBytes);
     return std::max({tracing, building, pilot});
   };
@@ -81,8 +92,8 @@ uint64_t photonMemoryBytes(const PerMap<size_t>& stored, bool spaceTime4D, int m
   uint64_t held = 0, most = 0;
   for (MapKind k : kAllMapKinds) {
     const uint64_t perPath = mapKindInfo(k).storesEveryBounce ? uint64_t(std::max(1, maxDepth)) + 1 : 1;
-    most = std::max(most, held + peak(stored[k], perPath));
-    held += kept(stored[k]);
+    most = std::max(most, held + peak(k, stored[k], perPath));
+    held += kept(k, stored[k]);
   }
   return most;
 }
@@ -99,6 +110,7 @@ void checkPhotonMemory(const PerMap<size_t>& stored, bool spaceTime4D, int maxDe
   // Blame the count that alone does not fit, else all together.
   std::string what, names, counts;
   for (MapKind k : kAllMapKinds) {
+    if (mapKindInfo(k).onlyWhenAsked && stored[k] == 0) continue;  // no volume map: not named
     PerMap<size_t> alone;
     alone[k] = stored[k];
     const std::string count = std::to_string(stored[k]) + " " + mapKindName(k);
@@ -153,6 +165,7 @@ void checkMemoryBudget(const Scene& scene, const RenderOptions& opt, int threads
     throw Error(image + " needs about " + imageNeeds + limits + "; lower the resolution");
   std::string maps;
   for (MapKind k : kAllMapKinds)
+    if (mapKindInUse(opt, k))
     maps += (maps.empty() ? "" : ", ") + opt.*mapKindInfo(k).photonsSource + ": " + std::to_string(p.stored[k]) + " " +
             mapKindName(k);
   throw Error(image + " and the photon maps (" + maps + ") together need about " + formatBytes(e.peak()) + ": " + imageNeeds + " and " +

@@ -2,7 +2,11 @@
 // maps: trace each kind, then build its tree(s).
 #include "render/photon_map.h"
 
+#include <cmath>
+
 #include "core/timer.h"
+#include "estimate/estimators.h"
+#include "scene/render_method.h"
 
 namespace tdpm {
 
@@ -34,11 +38,20 @@ PerMap<PhotonMapSettings> photonMapSettingsFor(const RenderOptions& opt, const P
     ms.trace.spreadInTime = spreadInTime;
     ms.trace.fixedTime01 = fixedTime01;
   }
+  photon::BeamBuildOptions& beam = all[MapKind::Volume].beam;
+  beam.kind = renderMethodTraits(opt.method).timeDependentEstimate ? photon::BeamBuildOptions::Kind::Time
+                                                                   : photon::BeamBuildOptions::Kind::Standard;
+  beam.ks = opt.estimate.ks;
+  beam.fraction = opt.estimate.fraction;
+  beam.maxTimeDistance = opt.estimate.maxTimeDistance;
+  beam.minTimePhotons = estimate::kMinTimePhotons;
+  all[MapKind::Volume].maxDtFraction = opt.maxDtFraction;
   return all;
 }
 
 double PhotonMap::bytesPerPhoton() const {
   if (store.empty()) return 0.0;
+  if (beams.size() > 0) return beams.bytesPerPhoton();
   double bytes = double(store.bytesAllocated()) + double(store3.bytesAllocated());
   return bytes / double(store.size());
 }
@@ -56,6 +69,19 @@ std::unique_ptr<PhotonMap> buildPhotonMap(const Scene& scene, const PhotonMapSet
   opt.spaceTime = settings.spaceTime;
   opt.kappa = settings.kappa;
   opt.comm = settings.trace.comm;  // under mpirun the ranks share the build
+  if (settings.trace.kind == MapKind::Volume) {
+    photon::BeamBuildOptions beam = settings.beam;
+    if (beam.kind == photon::BeamBuildOptions::Kind::Time && !scene.hasMotion)
+      beam.kind = photon::BeamBuildOptions::Kind::Standard;
+    if (!std::isfinite(beam.maxTimeDistance)) {
+      float ts = std::isfinite(settings.trace.timeOpen) ? settings.trace.timeClose - settings.trace.timeOpen
+                                                        : scene.shutter.length();
+      beam.maxTimeDistance = settings.maxDtFraction * ts;
+    }
+    if (!map->store.empty()) map->beams = photon::VolumeBeamMap::build(map->store, beam);
+    map->buildSeconds = timer.seconds();
+    return map;
+  }
   if (settings.spaceTime) {
     map->store3 = map->store;
     photon::KdBuildOptions opt3;

@@ -2,6 +2,20 @@
 // its kd-tree (3D, or 4D for the space-time search, with a 3D copy for the
 // standard estimate on paths that meet no motion), and what it cost.
 // Held by pointer: a KdTree points into its store, so a map never moves.
+//
+// The volume map (MapKind::Volume, scenes with media only) is a beam map
+// instead: `beams` (photon/volume_beam_map.h) holds the kd-tree over
+// `store` and every photon's disc radius and time half-width; `tree`,
+// `store3` and `tree3` stay empty. Its kernels (PhotonMapSettings::beam):
+//   time      Kind::Time, k_s = the render's ks, the fraction the surface's,
+//             max time distance the surface's (max_dt, else maxDtFraction
+//             of the shutter), where the method is time-dependent and the
+//             scene moves;
+//   standard  Kind::Standard (k = ks) otherwise (static, standard,
+//             accumulation frames, a still scene);
+//   pass      Kind::Fixed with the pass's kernel (render/progressive.cpp).
+// The eye side reads maps[MapKind::Volume]->beams; it is empty (size 0)
+// when the scene has no media (no volume map traced).
 #pragma once
 #include <memory>
 #include <string>
@@ -9,6 +23,7 @@
 #include "core/progress.h"
 #include "photon/kdtree.h"
 #include "photon/tracer.h"
+#include "photon/volume_beam_map.h"
 #include "render/map_kinds.h"
 #include "render/render_options.h"
 
@@ -19,6 +34,7 @@ struct PhotonMap {
   photon::KdTree tree;         // 3D, or 4D when built for the space-time search
   photon::PhotonStore store3;  // 4D maps only: a 3D-ordered copy
   photon::KdTree tree3;
+  photon::VolumeBeamMap beams;  // MapKind::Volume only: built over `store` (see the top)
   // Animations (render/animation.h): store3/tree3 hold only the frame's own
   // shutter, for the standard estimate, while `tree` spans the frame's time
   // window (its shutter plus what the time kernel may reach).
@@ -37,6 +53,11 @@ struct PhotonMapSettings {
   photon::PathRange pass;  // a progressive pass's paths; pass.paths 0: sized by the tracer's pilot
   bool spaceTime = false;  // build the 4D tree (plus a 3D copy)
   float kappa = 1.0f;
+  // MapKind::Volume: the beam kernels (see the top). A Time kernel on a
+  // scene without motion is built as Standard; an infinite
+  // maxTimeDistance becomes maxDtFraction of the shutter.
+  photon::BeamBuildOptions beam;
+  float maxDtFraction = 0.1f;
 };
 
 // Whether the options gather from a global map at all (final gather rays,

@@ -53,6 +53,11 @@ struct RenderOptions {
   // points at these and at their sources below).
   size_t causticPhotons = 200000;
   size_t globalPhotons = 50000;
+  // Volume photons (scattering events in media): 0, no volume map, unless
+  // the scene has media (cli/render_command.cpp then defaults it to
+  // kDefaultVolumePhotons; --volume-photons, render.volume_photons).
+  size_t volumePhotons = 0;
+  static constexpr size_t kDefaultVolumePhotons = 100000;
   int frames = 8;                  // accumulation: in-between frames
   bool spaceTime4D = false;        // --search 4d
   float kappa = 1.0f;              // 4D metric weight
@@ -83,6 +88,7 @@ struct RenderOptions {
   // the flag, or the scene key and file (cli/render_command.cpp sets these).
   std::string causticPhotonsSource = "--photons";
   std::string globalPhotonsSource = "--global-photons";
+  std::string volumePhotonsSource = "--volume-photons";
   // How the image size was set, for the memory-budget error.
   std::string resolutionSource = "the camera resolution";
 

@@ -289,6 +289,7 @@ struct RenderSettings {
   // resolution after --resolution. Not with `photons`.
   std::optional<int64_t> photonsPerPixel;
   std::optional<int64_t> globalPhotons;   // global photons stored, >= 0
+  std::optional<int64_t> volumePhotons;   // volume photons stored (scenes with media), >= 0
   std::optional<int> frames;              // accumulation, >= 1
   std::optional<std::string> search;      // twopass | 4d
   std::optional<int> k;                   // photons in the spatial search, >= 1

@@ -507,6 +507,7 @@ SceneJson sceneToJson(const scene::SceneDescription& sc, const std::string& json
   if (r.photons) render["photons"] = *r.photons;
   if (r.photonsPerPixel) render["photons_per_pixel"] = *r.photonsPerPixel;
   if (r.globalPhotons) render["global_photons"] = *r.globalPhotons;
+  if (r.volumePhotons) render["volume_photons"] = *r.volumePhotons;
   if (r.frames) render["frames"] = *r.frames;
   if (r.search) render["search"] = *r.search;
   if (r.k) render["k"] = *r.k;

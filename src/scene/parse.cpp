@@ -1284,7 +1284,7 @@ RenderSettings readRender(const Node& n, float shutterLength) {
   n.expectObject({"method", "spp", "max_spp", "contrast", "seed", "max_depth", "exposure", "photons", "global_photons",
                   "frames", "search", "k", "fraction", "kappa", "max_radius", "max_dt", "kernel_space", "kernel_time",
                   "gather", "sampler", "filter", "filter_radius", "progressive", "passes", "time_limit", "direct_only",
-                  "photons_per_pixel"});
+                  "photons_per_pixel", "volume_photons"});
   RenderSettings r;
   if (n.has("method")) r.method = n.member("method").choice(renderMethodNames(), "render method");
   if (n.has("spp")) r.spp = readCount(n.member("spp"), "spp", limits::kSpp);
@@ -1298,6 +1298,7 @@ RenderSettings readRender(const Node& n, float shutterLength) {
   if (n.has("exposure")) r.exposure = readFloatInRange(n.member("exposure"), "exposure", limits::kExposure);
   if (n.has("photons")) r.photons = readInRange(n.member("photons"), "photons", limits::kPhotons);
   if (n.has("global_photons")) r.globalPhotons = readInRange(n.member("global_photons"), "global_photons", limits::kPhotons);
+  if (n.has("volume_photons")) r.volumePhotons = readInRange(n.member("volume_photons"), "volume_photons", limits::kPhotons);
   if (n.has("frames")) r.frames = readCount(n.member("frames"), "frames", limits::kFrames);
   if (n.has("search")) r.search = n.member("search").choice(kSearches, "search");
   if (n.has("k")) r.k = readCount(n.member("k"), "k", limits::kK);
