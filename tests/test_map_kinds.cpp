@@ -71,3 +71,24 @@ TEST_CASE("map kinds: the memory model holds the maps before the one being trace
         CHECK(photonMemoryBytes({c, g}, st4, 16) == std::max(alone, kept + globalAlone));
       }
 }
+
+TEST_CASE("map kinds: the volume map is named only where it is traced") {
+  CHECK(std::string(mapKindName(MapKind::Volume)) == "volume");
+  CHECK(std::string(mapKindInfo(MapKind::Volume).optionName) == "volume_photons");
+  RenderOptions o;
+  o.method = RenderMethod::Time;
+  RenderStats st;
+  // No media (volumePhotons 0): no key, as before the kind existed.
+  auto m = cli::renderMetadata("s.json", o, st);
+  CHECK(m.count("tdpm/volume_photons") == 0);
+  CHECK(m.count("tdpm/caustic_photons") == 1);
+  CHECK(!mapKindReported(MapKind::Volume, st.maps[MapKind::Volume]));
+  CHECK(mapKindReported(MapKind::Global, st.maps[MapKind::Global]));
+  o.volumePhotons = 10;
+  st.maps[MapKind::Volume].stored = 11;
+  st.maps[MapKind::Volume].emitted = 4096;
+  m = cli::renderMetadata("s.json", o, st);
+  CHECK(m.at("tdpm/volume_photons") == "11");
+  CHECK(mapKindReported(MapKind::Volume, st.maps[MapKind::Volume]));
+  CHECK(photonsWanted(o)[MapKind::Volume] == 10);
+}

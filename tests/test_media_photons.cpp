@@ -13,9 +13,13 @@
 #include <string>
 #include <vector>
 
+#include "cli_harness.h"
 #include "core/rng.h"
 #include "photon/tracer.h"
+#include "image/exr.h"
 #include "render/photon_map.h"
+#include "render/progressive.h"
+#include "render/progressive_io.h"
 #include "scene/scene.h"
 #include "scene_fixtures.h"
 
@@ -94,10 +98,13 @@ TEST_CASE("media photons: single scattering around a point light matches sigma_s
   };
   const Case cases[] = {{Rgb(0.2f), Rgb(0.6f)}, {Rgb(0.1f, 0.3f, 0.05f), Rgb(0.4f, 0.9f, 1.6f)}};
   const Rgb P(30.0f, 20.0f, 10.0f);
+  for (SamplerKind sampler : {SamplerKind::Random, SamplerKind::Sobol})
   for (const Case& c : cases) {
     auto s = Scene::build(pointInFog(c.sa, c.ss, P));
     REQUIRE(s->hasMedia());
-    photon::TraceResult r = photon::tracePhotons(*s, volumeTrace(60000, 0), Progress{});
+    photon::TraceSettings settings = volumeTrace(60000, 0);
+    settings.sampler = sampler;
+    photon::TraceResult r = photon::tracePhotons(*s, settings, Progress{});
     REQUIRE(r.emitted > 0);
     const double ts = 1.0;  // shutter [0, 1]
     const float shells[] = {0.0f, 0.3f, 1.0f, 2.0f, 4.0f};
@@ -310,4 +317,72 @@ TEST_CASE("media photons: the render builds a beam map for the volume kind, none
   CHECK(!mapKindInUse(plainOpt, MapKind::Volume));
   CHECK(mapKindInUse(plainOpt, MapKind::Global));
   CHECK(photonsWanted(plainOpt)[MapKind::Volume] == 0);
+}
+
+TEST_CASE("media photons: a scene without media reports no volume map, whatever --volume-photons says") {
+  const std::string dir = test::makeTempDir();
+  test::writeFile(dir + "/s.json", R"({"camera": {"position": [0, 1, 4], "target": [0, 0.5, 0], "resolution": [8, 6]},
+    "materials": {"glass": {"type": "dielectric", "ior": 1.5}},
+    "objects": [{"shape": {"type": "quad", "size": [4, 4]}}, {"shape": {"type": "sphere", "radius": 0.3},
+                 "material": "glass", "transform": {"translate": [0, 0.6, 0]}}],
+    "lights": [{"type": "point", "position": [0, 2, 0], "power": [50, 50, 50]}]})");
+  for (const std::string extra : {"", " --volume-photons 5000"}) {
+    test::CommandResult r = test::runTdpm("render '" + dir + "/s.json' -m time --photons 2000 --global-photons 1000 -q "
+                                          "--stats -t 1 --spp 1 -o '" + dir + "/o.exr'" + extra);
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    CHECK(r.output.find("caustic photons:") != std::string::npos);
+    CHECK(r.output.find("global photons:") != std::string::npos);
+    CHECK(r.output.find("volume") == std::string::npos);
+  }
+}
+
+TEST_CASE("media photons: progressive passes trace fresh volume photons with the pass's fixed beam kernel, kept in the state") {
+  // The photon side of progressive media (the eye side and the renderer's
+  // refusal are render/renderer.cpp's): pass 0's volume map is the pilot,
+  // every pass's map a Fixed beam map; the pilot kernel and the paths per
+  // pass go into the state and come back from its EXR attributes exactly.
+  auto d = pointInFog(Rgb(0.1f), Rgb(0.5f), Rgb(10.0f));
+  d.materials.push_back(test::diffuse(Rgb(0.5f)));
+  d.objects.push_back(test::quad({6, 6}, {0, -1, 0}, 0));
+  auto s = Scene::build(d);
+  RenderOptions opt;
+  opt.method = RenderMethod::Time;
+  opt.progressive = true;
+  opt.passes = 2;
+  opt.spp = 1;
+  opt.causticPhotons = 0;
+  opt.globalPhotons = 2000;
+  opt.volumePhotons = 3000;
+  ProgressiveState state;
+  RenderStats st;
+  renderProgressive(*s, opt, state, Progress{}, st);
+  REQUIRE(state.passesDone == 2);
+  const ProgressiveMapPilot& v = state.pilot.maps[MapKind::Volume];
+  CHECK(v.pathsPerPass > 0);
+  CHECK(std::fmod(v.pathsPerPass, double(photon::kPathsPerBatch)) == 0.0);
+  CHECK(v.radius > 0);
+  CHECK(v.radius < 10.0);  // k-NN discs of 3000 photons in a fog of mean free path 1.7: about 2
+  // Two passes of the same paths per pass: about twice the photons of one.
+  CHECK(st.maps[MapKind::Volume].emitted == uint64_t(2 * v.pathsPerPass));
+  CHECK(st.maps[MapKind::Volume].stored > 4000);
+  REQUIRE(state.settings.count("volume_photons") == 1);
+  image::ExrFile exr;
+  exr.color = image::ImageRgb(s->camera.width(), s->camera.height(), Rgb(0.0f));
+  addProgressiveState(state, exr);
+  CHECK(exr.metadata.count("tdpm/progressive/scalar/kernel.volume.radius_1") == 1);
+  std::optional<ProgressiveState> back = progressiveStateOf(exr, "p.exr");
+  REQUIRE(back);
+  CHECK(back->pilot == state.pilot);
+  // A state without the volume map's setting carries none of its scalars.
+  ProgressiveState plain = state;
+  plain.settings.erase("volume_photons");
+  image::ExrFile exr2;
+  exr2.color = exr.color;
+  addProgressiveState(plain, exr2);
+  CHECK(exr2.metadata.count("tdpm/progressive/scalar/kernel.volume.radius_1") == 0);
+  CHECK(exr2.metadata.count("tdpm/progressive/scalar/kernel.global.radius_1") == 1);
+  std::optional<ProgressiveState> back2 = progressiveStateOf(exr2, "p.exr");
+  REQUIRE(back2);
+  CHECK(back2->pilot.maps[MapKind::Global] == state.pilot.maps[MapKind::Global]);
 }

@@ -51,6 +51,7 @@ struct Setup {
     st.pilot.maps[MapKind::Caustic].pathsPerPass = 10 * 1024;
     st.pilot.maps[MapKind::Global].pathsPerPass = 2 * 1024;
     for (MapKind k : kAllMapKinds) {
+      if (mapKindInfo(k).onlyWhenAsked) continue;  // the volume map is not in progressive states
       ProgressiveMapPilot& m = st.pilot.maps[k];
       m.radius = m.halfWindow = m.spatialRadius = 0.125;
     }

@@ -23,6 +23,7 @@
 #include "core/timer.h"
 #include "distributed/comm.h"
 #include "estimate/estimators.h"
+#include "estimate/volume_estimators.h"
 #include "photon/tracer.h"
 #include "render/camera_sample.h"
 #include "render/pixel_loop.h"
@@ -132,6 +133,56 @@ void storeKernel(ProgressiveMapPilot& pilot, const estimate::MapKernel& k) {
 float mainAlpha(const RenderOptions& opt) {
   if (opt.alpha > 0) return opt.alpha;
   return renderMethodTraits(opt.method).defaultShrink == KernelShrink::SpaceTime ? kAlphaSpaceTime : kAlphaSpatial;
+}
+
+// ---- the volume map's pass kernels (beam estimate; scenes with media) ----
+// Pass 0's volume photons are built with the render's k-NN kernels (Time or
+// Standard, render/photon_map.h) as the pilot: the medians of their disc
+// radii and half windows (estimate::pilotKernel) are pass 1's kernel, kept
+// in state.pilot.maps[Volume] (radius, halfWindow; spatialRadius = radius).
+// Every pass's map, pass 0's included (rebuilt), is then a Fixed beam map:
+//   time-dependent: estimate::beamKernelForPass (disc x window, d = 3, the
+//     main alpha), r^2 h following the schedule in whole time bins;
+//   otherwise: the whole shutter, the radius by kernelScale(pass, alpha, 2).
+estimate::MapKernel volumePilotKernel(const PhotonMap& map, const Scene& scene, const RenderOptions& opt,
+                                      bool timeDependent) {
+  estimate::MapKernel k = pilotKernel(nullptr, scene, opt, timeDependent);  // the defaults of an empty map
+  if (map.beams.size() == 0) return k;
+  estimate::VolumeKernel v = estimate::pilotKernel(map.beams);
+  float floorR = 1e-6f * scene.extent();
+  k.radius = k.spatialRadius = std::max(v.radius, floorR);
+  k.halfWindow = std::max(v.halfWindow, float(shutterOf(scene, opt) / photon::kTimeBins));
+  return k;
+}
+
+photon::BeamBuildOptions volumePassBeam(const ProgressiveMapPilot& pilot, const Scene& scene, const RenderOptions& opt,
+                                        int pass, bool timeDependent) {
+  photon::BeamBuildOptions b;
+  b.kind = photon::BeamBuildOptions::Kind::Fixed;
+  const double alpha = mainAlpha(opt);
+  if (timeDependent) {
+    const float binWidth = float(shutterOf(scene, opt) / photon::kTimeBins);
+    estimate::BeamPassKernel k = estimate::beamKernelForPass(
+        estimate::VolumeKernel{float(pilot.radius), float(pilot.halfWindow)}, pass, binWidth, float(alpha));
+    b.fixedRadius = k.radius;
+    b.fixedWindowCode = k.windowCode;
+  } else {
+    b.fixedRadius = float(pilot.radius * kernelScale(pass, alpha, 2));
+    b.fixedWindowCode = photon::kWholeShutter;
+  }
+  return b;
+}
+
+// Pass 0: the volume pilot into the state, then pass 0's map rebuilt with
+// its own fixed kernel, as every later pass's. Returns the rebuild's seconds.
+double takeVolumePilot(ProgressiveState& state, PhotonMap& volume, const Scene& scene, const RenderOptions& opt,
+                       int pass, bool timeDependent) {
+  ProgressiveMapPilot& pilot = state.pilot.maps[MapKind::Volume];
+  storeKernel(pilot, volumePilotKernel(volume, scene, opt, timeDependent));
+  if (volume.beams.size() == 0) return 0.0;
+  Timer rebuild;
+  volume.beams = photon::VolumeBeamMap::build(volume.store, volumePassBeam(pilot, scene, opt, pass, timeDependent));
+  return rebuild.seconds();
 }
 
 template <class Integrator>
@@ -317,6 +368,9 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
     TDPM_ASSERT(paths == 0 || uint64_t(pass) + 1 <= UINT64_MAX / paths, "progressive photon path index overflows");
     settings[kind].pass.firstPath = uint64_t(pass) * paths;
   }
+  const bool timeDependent = renderMethodTraits(opt.method).timeDependentEstimate && scene.hasMotion;
+  if (state.pilot.done)  // the volume map's pass kernel (pass 0 has its pilot first: below)
+    settings[MapKind::Volume].beam = volumePassBeam(state.pilot.maps[MapKind::Volume], scene, opt, pass, timeDependent);
   PhotonMaps maps = buildPhotonMaps(scene, settings, progress);
   double photonSeconds = 0;
   for (MapKind kind : kAllMapKinds) {
@@ -327,9 +381,10 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
   }
 
   // ---- kernels: pass 1's from a k-NN pilot on pass 0's maps ----
-  const bool timeDependent = renderMethodTraits(opt.method).timeDependentEstimate && scene.hasMotion;
   if (!state.pilot.done) {
-    for (MapKind kind : kAllMapKinds) storeKernel(state.pilot.maps[kind], pilotKernel(maps[kind], scene, opt, timeDependent));
+    for (MapKind kind : kAllMapKinds)
+      if (kind != MapKind::Volume) storeKernel(state.pilot.maps[kind], pilotKernel(maps[kind], scene, opt, timeDependent));
+    photonSeconds += takeVolumePilot(state, *maps.maps[MapKind::Volume], scene, opt, pass, timeDependent);
     state.pilot.done = true;
     if (afterPilot) afterPilot();
   }

@@ -43,13 +43,14 @@ std::vector<std::string> splitNames(const std::string& s) {
 
 }  // namespace
 
-std::vector<ProgressiveScalar> progressiveScalars(const ProgressiveState& s) {
+std::vector<ProgressiveScalar> progressiveScalars(const ProgressiveState& s, bool allKinds) {
   using R = ProgressiveScalarRole;
   std::vector<ProgressiveScalar> v;
-  // The volume map (onlyWhenAsked) is not part of progressive states:
-  // progressive renders of scenes with media are refused
-  // (render/renderer.cpp checkMediaSupport), so states keep their format.
-  auto inState = [](MapKind k) { return !mapKindInfo(k).onlyWhenAsked; };
+  // The volume map (onlyWhenAsked) only where the settings name its count
+  // (render/progressive.cpp writes it only when the map is traced).
+  auto inState = [&](MapKind k) {
+    return allKinds || !mapKindInfo(k).onlyWhenAsked || s.settings.count(mapKindInfo(k).optionName) > 0;
+  };
   for (MapKind k : kAllMapKinds)
     if (inState(k))
     v.push_back({std::string("photons.") + mapKindName(k) + "_paths_per_pass", R::Paths, k, &s.pilot.maps[k].pathsPerPass});
@@ -151,8 +152,9 @@ std::optional<ProgressiveState> progressiveStateOf(const image::ExrFile& exr, co
   state.fingerprint = need("fingerprint");
   // The scalars by their names on disk; `state` is ours, so its fields may be written through the table.
   std::map<std::string, double*> fields;
-  for (const ProgressiveScalar& sc : progressiveScalars(state)) fields[sc.name] = const_cast<double*>(sc.value);
+  for (const ProgressiveScalar& sc : progressiveScalars(state, true)) fields[sc.name] = const_cast<double*>(sc.value);
   size_t found = 0;
+  std::vector<std::string> foundNames;
   for (const auto& [key, value] : exr.metadata) {
     if (!startsWith(key, kAttr)) continue;
     const std::string name = key.substr(kAttr.size());
@@ -165,11 +167,20 @@ std::optional<ProgressiveState> progressiveStateOf(const image::ExrFile& exr, co
       if (field == fields.end()) throw bad(key + " is not a value a progressive render writes");
       *field->second = v;
       ++found;
+      foundNames.push_back(name.substr(7));
     }
+  }
+  // A kind's scalars only where its settings are (progressiveScalars).
+  {
+    std::set<std::string> expected;
+    for (const ProgressiveScalar& sc : progressiveScalars(state)) expected.insert(sc.name);
+    for (const std::string& n : foundNames)
+      if (!expected.count(n)) throw bad(kAttr + "scalar/" + n + " is not a value a progressive render writes");
   }
   // All of them (the pilot is done) or none (pass 0 never ended).
   state.pilot.done = found > 0;
-  if (found > 0 && found < fields.size())
+  // (the settings are read now: the list of the kinds this state holds)
+  if (found > 0)
     for (const ProgressiveScalar& sc : progressiveScalars(state))
       if (!exr.metadata.count(kAttr + "scalar/" + sc.name)) throw bad(kAttr + "scalar/" + sc.name + " is missing");
   // The layers hold floats that must come back exactly: a file converted

@@ -45,7 +45,12 @@ struct ProgressiveScalar {
   MapKind kind;  // Paths and Kernel only
   const double* value;
 };
-std::vector<ProgressiveScalar> progressiveScalars(const ProgressiveState& state);
+// A kind that is part of a render only when asked (the volume map,
+// render/map_kinds.h onlyWhenAsked) has its scalars only in a state whose
+// settings name its count ("volume_photons": a scene with media), so a
+// state without media keeps the scalars it had before; allKinds lists
+// every kind's (the reader's table, before it has read the settings).
+std::vector<ProgressiveScalar> progressiveScalars(const ProgressiveState& state, bool allKinds = false);
 
 // Adds `state` to `exr` (channels and attributes as above), replacing any
 // state already there. Every layer must have exr.color's pixel count, and
