@@ -543,8 +543,8 @@ TEST_CASE("media: bad media input on the command line: located error, nothing wr
         "s.json:1: objects[0].medium: an interior medium needs a closed shape");
   check(sceneWith(kFog, "[]", R"("exterior_medium": "mist")"), "", "exterior_medium: unknown medium \"mist\"");
   check(sceneWith(R"("fog": {"type": "homogeneous", "sigma_a": 1, "sigma_s": 1, "g": 2})"), "", "media.fog.g:");
-  check(sceneWith(kFog, "[]", R"("exterior_medium": "fog")"), "-m time --resolution 4x4",
-        "need -m pathtrace");
+  check(sceneWith(kFog, "[]", R"("exterior_medium": "fog")"), "-m static --resolution 4x4",
+        "need -m pathtrace, time or standard");
 }
 
 TEST_CASE("media: the scene digest covers the media and where they are") {
