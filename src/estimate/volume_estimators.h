@@ -188,8 +188,11 @@ struct BeamReport {
 };
 
 // The beam estimate along seg at time t (header). Standard maps (every
-// window the whole shutter) ignore t.
-template <class Phase, class Tr>
+// window the whole shutter) ignore t. kTimeless: the standard form on
+// any map, every photon's window the whole shutter (the eye side's skip
+// rule on a Time map: the same discs, the time average; unbiased by the
+// same Mecke argument, as each photon's kernel still integrates to one).
+template <bool kTimeless = false, class Phase, class Tr>
 Rgb beamRadiance(const photon::VolumeBeamMap& map, photon::BeamQuery& q, const Segment& seg, float t,
                  const Phase& phase, const Tr& tr, BeamReport* report = nullptr) {
   const photon::PhotonStore& s = map.store();
@@ -208,7 +211,7 @@ Rgb beamRadiance(const photon::VolumeBeamMap& map, photon::BeamQuery& q, const S
     ++crossed;
     float wt = 1.0f / float(photon::kTimeBins);
     const uint8_t code = wc[i];
-    if (code != photon::kWholeShutter) {
+    if (!kTimeless && code != photon::kWholeShutter) {
       // Bins [q - w, q + w], i.e. [lo, hi1) in bin units (half-open: a
       // query on a bin boundary sees 2w + 1 bins, not 2w).
       const int w = code, qb = flags[i] & photon::kTimeMask;

@@ -21,6 +21,14 @@ namespace tdpm {
 template <class Stream>
 Rgb directLight(const Scene& scene, const Hit& hit, const ShadingContext& ctx, float time01, Stream& sampler,
                 int vertex, int bsdfSamples, const GuideCones* guide = nullptr);
+// Scenes with media: the same, each shadow ray weighted by its
+// transmittance through media and interface surfaces
+// (render/media_transport.h), starting in the medium on the side of the
+// hit it leaves into (`medium`: the path's medium at the hit, kept where
+// the object bounds no media); rng: the sample's medium stream.
+template <class Stream>
+Rgb directLightMedia(const Scene& scene, const Hit& hit, const ShadingContext& ctx, float time01, Stream& sampler,
+                     int vertex, int bsdfSamples, const GuideCones* guide, int32_t medium, Rng& rng);
 
 // MIS weight of a BSDF-sampled ray (one of `bsdfSamples`, density
 // bsdfPdf) that hit an area light which light sampling would have chosen

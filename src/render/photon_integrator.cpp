@@ -46,7 +46,11 @@ constexpr size_t kGuideLightTests = 8;
 
 PhotonIntegrator::PhotonIntegrator(const Scene& scene, const PerMap<const PhotonMap*>& maps,
                                    const PhotonIntegratorSettings& settings)
-    : scene_(scene), caustic_(maps[MapKind::Caustic]), global_(maps[MapKind::Global]), s_(settings) {
+    : scene_(scene),
+      caustic_(maps[MapKind::Caustic]),
+      global_(maps[MapKind::Global]),
+      volume_(maps[MapKind::Volume]),
+      s_(settings) {
   // The floor of r^2 (coincident photons) relative to the scene: an
   // absolute 1e-12 m^2 is a disc as large as a whole scene at 1e-6 scale,
   // which blurred its caustic away (max 0.58 instead of 8).
@@ -289,6 +293,7 @@ Rgb PhotonIntegrator::eyePart(Vec3f origin, Vec3f dir, float time01, Stream& sam
 // prefix of All's: the same path and shadow rays for the same stream).
 template <PhotonIntegrator::Part kPart, class Stream>
 Rgb PhotonIntegrator::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts, Rgb* eye) const {
+  if (scene_.hasMedia()) return traceMedia<kPart>(origin, dir, time01, sampler, ts, eye);
   EyeVertex v;
   // A moving camera sees a different surface point at each time: never
   // the fixed-point time average, so always the time-dependent estimate.

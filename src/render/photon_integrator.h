@@ -11,6 +11,8 @@
 // through the swept bounds of anything moving, or whose camera moves, uses
 // the time-dependent estimate; any other uses the standard one, which is
 // exactly the time average the pixel wants there. Counts of both are kept.
+// Scenes with participating media take their own eye path
+// (render/photon_integrator_media.cpp; one branch on Scene::hasMedia()).
 #pragma once
 #include <cstdint>
 #include <array>
@@ -72,6 +74,7 @@ class PhotonIntegrator {
     std::unique_ptr<estimate::FixedKernelGatherer> fixed;  // fixedKernels only
     EstimateCounts counts;
     photon::KnnQuery guideQuery;  // the gather guide's photons (gatherGuide)
+    std::unique_ptr<photon::BeamQuery> beams;  // scenes with media: the volume map's beam queries
   };
 
   // The maps by kind (PhotonMaps::view(), render/photon_map.h); null or
@@ -133,10 +136,23 @@ class PhotonIntegrator {
   void gatherCones(const Hit& hit, const struct ShadingContext& ctx, float time01, ThreadState& ts,
                    GuideCones& cones) const;
   bool towardLight(Vec3f p, Vec3f w, float time01) const;
+  // ---- scenes with media (render/photon_integrator_media.cpp) ----
+  template <Part kPart, class Stream>
+  Rgb traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts, Rgb* eye) const;
+  template <class Stream>
+  Rgb finalGatherMedia(const Hit& hit, const struct ShadingContext& ctx, float time01, bool touched, int32_t medium,
+                       Stream& sampler, int vertex, ThreadState& ts, const GuideCones& cones, Rng& rng,
+                       Rng& beamRng) const;
+  // One piece of an eye or gather ray in `medium`, [0, tEnd] from o along
+  // d: returns beta x the in-scattered radiance along it from the volume
+  // map (none when !withEstimate) and multiplies beta by its transmittance.
+  Rgb mediumSegment(Vec3f o, Vec3f d, float tEnd, int32_t medium, float time01, bool timeDependent, bool withEstimate,
+                    Rgb& beta, ThreadState& ts, Rng& rng, Rng& beamRng) const;
 
   const Scene& scene_;
   const PhotonMap* caustic_;
   const PhotonMap* global_;
+  const PhotonMap* volume_;  // MapKind::Volume (beams), scenes with media
   PhotonIntegratorSettings s_;
   mutable std::atomic<uint64_t> standardCount_{0}, timeCount_{0};
   mutable std::array<std::atomic<uint64_t>, kMapKinds> mapCount_{}, fewCount_{};

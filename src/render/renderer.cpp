@@ -431,21 +431,28 @@ void gatherFilm(dist::Comm& comm, TileOwners& owners, RenderStats& st, Film& fil
 
 }  // namespace
 
-void checkMediaSupport(const Scene& scene, const RenderOptions& opt) {
+void checkMediaSupport(const Scene& scene, const RenderOptions& opt, bool stillImage) {
   if (!scene.hasMedia()) return;
-  if (opt.method != RenderMethod::PathTrace)
-    throw Error("the scene has participating media, which need -m pathtrace in this version (the volume photon map is "
-                "being built); method '" + std::string(renderMethodName(opt.method)) + "' would render it without them");
+  const bool photonMethod = opt.method == RenderMethod::Time || opt.method == RenderMethod::Standard;
+  if (opt.method != RenderMethod::PathTrace && !(stillImage && photonMethod))
+    throw Error("the scene has participating media, which need -m pathtrace, time or standard in this version" +
+                std::string(stillImage ? "" : " (animations and frames: pathtrace only)") + "; method '" +
+                std::string(renderMethodName(opt.method)) + "' would render it without them");
   if (opt.progressive)
     throw Error("the scene has participating media: progressive rendering does not support them in this version; "
-                "render with -m pathtrace without --progressive");
+                "render with -m pathtrace, time or standard without --progressive");
 }
 
 // One level: the memory check, the method's render, the gather.
 Film render(const Scene& scene, const RenderOptions& opt, const Progress& progress, RenderStats& st, dist::Comm& comm) {
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
-  checkMediaSupport(scene, opt);
+  checkMediaSupport(scene, opt, true);
   const RenderMethodTraits& method = renderMethodTraits(opt.method);
+  // Each rank would trace its own volume map the way the surface maps are
+  // shared; that path is not checked with media yet.
+  if (scene.hasMedia() && comm.distributed() && method.photonMaps)
+    throw Error("the scene has participating media: distributed (MPI) photon-map renders do not support them in this "
+                "version; render on one process or with -m pathtrace");
   if (opt.progressive) {  // render/progressive.h, from pass 0, on the same ranks
     ProgressiveState state;
     return renderProgressive(scene, opt, state, progress, st, comm);

@@ -40,12 +40,13 @@ inline constexpr uint64_t kSamplerBytesPerPixel = 61;
 // black background, lights of zero power (every render path reports them).
 std::vector<std::string> sceneWarnings(const Scene& scene);
 
-// Throws tdpm::Error when the scene has participating media and the
-// options ask for anything but (non-progressive) `pathtrace`: the volume
-// photon maps are not built in this version, and rendering the scene
-// without its media would silently show something else. render(),
-// renderFrame() and renderAnimation() call it first.
-void checkMediaSupport(const Scene& scene, const RenderOptions& options);
+// A located error when the scene has participating media and the options
+// ask for what does not render them: a still image (stillImage, render())
+// takes pathtrace, time or standard (the photon methods' eye side in media:
+// render/photon_integrator_media.cpp); animations and frames pathtrace only;
+// progressive rendering none (no progressive volume maps yet).
+// render(), renderFrame() and renderAnimation() call it first.
+void checkMediaSupport(const Scene& scene, const RenderOptions& options, bool stillImage = false);
 
 
 // Throws tdpm::Error, before any work, when the image and the photon maps

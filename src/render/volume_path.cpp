@@ -14,7 +14,7 @@
 //     sample, as render/path_tracer.cpp;
 //   - every shadow ray multiplies the transmittance of each medium it
 //     crosses (closed form / ratio tracking) through interface surfaces and
-//     stops at any other surface;
+//     stops at any other surface (render/media_transport.h);
 //   - MIS (power heuristic) between light sampling and phase / BSDF
 //     sampling for area and environment lights, with directional densities
 //     only: both strategies see the same transmittance (in expectation), so
@@ -30,6 +30,7 @@
 #include "media/medium.h"
 #include "media/phase.h"
 #include "render/direct_light.h"
+#include "render/media_transport.h"
 #include "render/path_tracer.h"
 #include "scene/bsdf.h"
 
@@ -38,45 +39,8 @@ namespace tdpm {
 namespace {
 
 constexpr int kRouletteStartDepth = 3;  // as render/path_tracer.cpp
-// Interface surfaces one path or shadow ray may cross: a bound against
-// pathological geometry (a ray grazing along a mesh of interfaces), far
-// above what any scene needs (a ray crosses each closed interface twice).
-constexpr int kMaxCrossings = 4096;
+constexpr int kMaxCrossings = kMaxMediumCrossings;  // render/media_transport.h
 constexpr float kInf = std::numeric_limits<float>::infinity();
-
-// The medium tracking's own random numbers (distances, event choices,
-// ratio tracking): a PCG stream seeded from one 2D draw of the sample's
-// stream, so that a sample stays a function of (seed, pixel, index).
-// The group (vertex 0's reserved light-choice slot, sub 1) is one no
-// other consumer draws.
-template <class Stream>
-Rng mediumRng(Stream& sampler) {
-  Vec2f s = sampler.get2D(dims::vertexGroup(0, dims::kLightChoice, 1));
-  uint64_t seed = (uint64_t(s.x * 16777216.0f) << 24) | uint64_t(s.y * 16777216.0f);
-  return Rng(seed, 0x6d65646961ull);  // "media"
-}
-
-// Transmittance from o along unit d over [0, tMax] starting in `medium`:
-// the product over the media crossed, through interface surfaces; zero at
-// any other surface (and at an emitter's).
-Rgb transmittanceTo(const Scene& s, Vec3f o, Vec3f d, float tMax, float time01, int32_t medium, Rng& rng) {
-  Rgb T(1.0f);
-  const Vec3f target = o + d * (std::isinf(tMax) ? 0.0f : tMax);
-  for (int crossing = 0; crossing < kMaxCrossings; ++crossing) {
-    Hit hit;
-    bool found = tMax > 0 && s.intersect(o, d, tMax, time01, hit);
-    if (medium >= 0) {
-      T = T * media::transmittance(s.media[size_t(medium)], o, d, found ? hit.t : std::max(tMax, 0.0f), time01, rng);
-      if (T.isBlack()) return T;
-    }
-    if (!found) return T;
-    if (hit.isLight() || !s.objects[hit.object].isInterface) return Rgb(0.0f);
-    medium = s.objects[hit.object].mediumAfter(hit.n, d, medium);
-    o = s.spawnOrigin(hit.p, hit.n, d);
-    if (!std::isinf(tMax)) tMax = dot(target - o, d);
-  }
-  return Rgb(0.0f);
-}
 
 // What scatters at a path vertex: a phase function (surface == null) or
 // a surface's BSDF. f includes the BSDF's |cos|.
