@@ -134,7 +134,7 @@ Rgb PhotonIntegrator::finalGatherMedia(const Hit& hit, const ShadingContext& ctx
       }
       const Material& mat = scene_.materialAt(h, -d);
       std::optional<Material> textured;
-      ShadingContext c = makeShadingContext(scene_.shadedMaterial(mat, h, textured), scene_.albedoAt(mat, h), h.n, -d);
+      ShadingContext c = scene_.shadingContext(mat, h, -d, textured);
       if (!mat.isCausticBounce()) {
         sum += beta * estimate(global_, ts.global, ts.global3, h, c, -d, time01, s_.timeDependent && moved, ts);
         break;
@@ -207,7 +207,7 @@ Rgb PhotonIntegrator::traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& 
     const SceneObject& obj = scene_.objects[hit.object];
     const Material& mat = scene_.materialAt(hit, -dir);
     std::optional<Material> textured;
-    ShadingContext ctx = makeShadingContext(scene_.shadedMaterial(mat, hit, textured), scene_.albedoAt(mat, hit), hit.n, -dir);
+    ShadingContext ctx = scene_.shadingContext(mat, hit, -dir, textured);
     bool timeDependent = s_.timeDependent && touched;
     float minVolume = s_.footprintVolume * pathLength * pathLength;
 
