@@ -5,6 +5,9 @@
 // box, one thread. Time per ray; the counter `mean` (mean transmittance, or
 // the share of flights that collide) must agree between the two within
 // noise: the same estimator, fewer null collisions (bench/README.md, "Media").
+// `dense:1`: the worst case for the majorant grid, a uniform grid (density 1
+// everywhere, sigma_t 4.5): no cell is below the global bound, so the DDA's
+// cell steps are pure overhead.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -20,7 +23,7 @@ namespace {
 // 64^3 cells on [0, 1]^3: a soft blob (radius 0.15, peak 8) off-centre and a
 // thin haze band (0.05) along the bottom, zero elsewhere: the shape of
 // bench/media/smoke_blob.py's scene. sigma_t = 4.5 per density, grey.
-scene::MediumDesc blob() {
+scene::MediumDesc blob(bool dense) {
   scene::MediumDesc d;
   d.type = scene::MediumDesc::Type::Grid;
   d.sigmaA = Rgb(0.5f);
@@ -35,6 +38,7 @@ scene::MediumDesc blob() {
         float d2 = (px * px + py * py + pz * pz) / (0.15f * 0.15f);
         float v = d2 < 4.0f ? 8.0f * std::exp(-2.0f * d2) : 0.0f;
         if ((y + 0.5f) / n < 0.08f) v += 0.05f;
+        if (dense) v = 1.0f;
         d.grid.density[(size_t(z) * n + size_t(y)) * n + size_t(x)] = v;
       }
   d.grid.bounds = {{0, 0, 0}, {1, 1, 1}};
@@ -55,9 +59,9 @@ struct Rays {
 };
 
 void BM_GridTransmittance(benchmark::State& state) {
-  static const scene::MediumDesc desc = blob();
+  static const scene::MediumDesc descs[2] = {blob(false), blob(true)};
   static const Rays rays;
-  const media::Medium m = media::makeMedium(desc, nullptr, nullptr, int(state.range(0)));
+  const media::Medium m = media::makeMedium(descs[state.range(1)], nullptr, nullptr, int(state.range(0)));
   Rng rng(5);
   double sum = 0;
   size_t n = 0;
@@ -71,9 +75,9 @@ void BM_GridTransmittance(benchmark::State& state) {
 }
 
 void BM_GridFreeFlight(benchmark::State& state) {
-  static const scene::MediumDesc desc = blob();
+  static const scene::MediumDesc descs[2] = {blob(false), blob(true)};
   static const Rays rays;
-  const media::Medium m = media::makeMedium(desc, nullptr, nullptr, int(state.range(0)));
+  const media::Medium m = media::makeMedium(descs[state.range(1)], nullptr, nullptr, int(state.range(0)));
   Rng rng(6);
   double hits = 0;
   size_t n = 0;
@@ -89,5 +93,5 @@ void BM_GridFreeFlight(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_GridTransmittance)->ArgName("cells")->Arg(1)->Arg(16);
-BENCHMARK(BM_GridFreeFlight)->ArgName("cells")->Arg(1)->Arg(16);
+BENCHMARK(BM_GridTransmittance)->ArgNames({"cells", "dense"})->ArgsProduct({{1, 16}, {0, 1}});
+BENCHMARK(BM_GridFreeFlight)->ArgNames({"cells", "dense"})->ArgsProduct({{1, 16}, {0, 1}});

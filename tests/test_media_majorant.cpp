@@ -108,6 +108,13 @@ TEST_CASE("majorant grid: every cell bounds the density anywhere in it, and empt
   REQUIRE(one.majorants->size() == 1);
   CHECK((*one.majorants)[0] == one.majorant);
   CHECK(one.majorant == m.majorant);
+  // A grid whose cells bound at least half the global majorant on average
+  // (here uniform, then mostly dense) collapses to one cell.
+  scene::MediumDesc uniform = cornerDesc(false);
+  for (float& v : uniform.grid.density) v = 1.0f;
+  CHECK(media::makeMedium(uniform, nullptr).majorants->size() == 1);
+  for (size_t i = 0; i < uniform.grid.density.size(); i += 7) uniform.grid.density[i] = 0.0f;
+  CHECK(media::makeMedium(uniform, nullptr).majorants->size() == 1);
 }
 
 TEST_CASE("majorant grid: ratio tracking keeps exp(-optical depth), still and moving, in every channel") {

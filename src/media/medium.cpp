@@ -91,6 +91,17 @@ void buildMajorantGrid(Medium& m, int cells) {
         // The same product as the global majorant's, so one cell reproduces it exactly.
         out[(size_t(k) * size_t(m.my) + size_t(j)) * size_t(m.mx) + size_t(i)] = sigmaT * mx;
       }
+  // Where the cells' bounds average at least half the global one the grid
+  // saves few null collisions and its DDA steps cost more than they save
+  // (bench_media.cpp, `dense:1`: a uniform grid tracked 1.8-2.1x slower
+  // through 16^3 cells than with one): one cell, the global majorant.
+  double mean = 0.0;
+  for (float c : out) mean += c;
+  mean /= double(out.size());
+  if (out.size() > 1 && mean >= 0.5 * double(sigmaT) * double(*std::max_element(v.begin(), v.end()))) {
+    m.mx = m.my = m.mz = 1;
+    out.assign(1, sigmaT * *std::max_element(v.begin(), v.end()));
+  }
   m.majorants = std::make_shared<const std::vector<float>>(std::move(out));
   Vec3f size = m.bounds.diagonal();
   m.majorantCellsPerUnit = {float(m.mx) / size.x, float(m.my) / size.y, float(m.mz) / size.z};
