@@ -27,7 +27,14 @@ Throughput at equal error, against sep: (T_sep relMSE_sep) / (T_v relMSE_v),
 i.e. the ratio of 1 / (time x error), which is the ratio of times at equal
 error where relMSE falls as 1 / time (printed for the mean and the median).
 --variants picks which of seq, ind, sep, same, shr to render (default all
-but shr; the reference is always needed unless --skip-ref)."""
+but shr; the reference is always needed unless --skip-ref).
+
+--seeds N renders N realisations: the sequences with --seed 1..N (into
+seq, seq.1, ...), the single frames with seeds 1000 + i + 100 k, and pools
+the errors of every frame of every realisation (CPU seconds: the mean per
+realisation). One seed is one realisation, not one per frame: a sequence's
+frames share random numbers (common random numbers, docs/animation.md
+section 4), so its frames' errors move together."""
 import argparse, json, os, shutil, subprocess, sys, time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -49,6 +56,48 @@ def compare(test, ref, crop=None):
     return json.loads(out)
 
 
+def vdir(out, v, k):
+    """Realisation k of variant v (k = 0: the directory of a one-seed run)."""
+    return "%s/%s" % (out, v) if k == 0 else "%s/%s.%d" % (out, v, k)
+
+
+def render_variants(a, k, variants, rng, frames, seq_args, win, own, single, out, times):
+    """Realisation k: the sequences with --seed k + 1, the single frames with seeds 1000 + i + 100 k."""
+    seed = ["--seed", str(k + 1)]
+    def put(v, t):
+        if not isinstance(times.get(v), dict):
+            times[v] = {}  # a one-seed run's times.json held a number
+        times[v][str(k)] = t
+    if "seq" in variants:
+        put("seq", cpu_run([TDPM, "render", a.scene, "-o", vdir(out, "seq", k) + "/f_####.exr", "--frame-range", rng]
+                           + seq_args + win + own + seed))
+    if "shr" in variants:
+        put("shr", cpu_run([TDPM, "render", a.scene, "-o", vdir(out, "shr", k) + "/f_####.exr", "--frame-range", rng]
+                           + seq_args + win + a.shr_args.split() + seed))
+    if "ind" in variants:
+        put("ind", cpu_run([TDPM, "render", a.scene, "-o", vdir(out, "ind", k) + "/f_####.exr", "--frame-range", rng,
+                            "--independent-frames"] + seq_args + win + own + seed))
+    for variant in ("sep", "same"):
+        if variant not in variants:
+            continue
+        d = vdir(out, variant, k)
+        os.makedirs(d, exist_ok=True)
+        total = 0.0
+        for i in frames:
+            s = str(1000 + i + 100 * k) if variant == "sep" else str(k + 1)
+            total += cpu_run([TDPM, "render", "%s/frame_%04d.json" % (single, i), "-o", "%s/f_%04d.exr" % (d, i),
+                              "--seed", s, "--fixed-budget"] + seq_args)
+        put(variant, total)
+
+
+def mean_time(times, v, seeds):
+    t = times.get(v)
+    if isinstance(t, dict):
+        got = [t[str(k)] for k in range(seeds) if str(k) in t]
+        return sum(got) / len(got) if got else float("nan")
+    return t if t is not None else float("nan")  # times.json of a one-seed run before --seeds
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("scene")
@@ -66,6 +115,9 @@ def main():
     ap.add_argument("--variants", default="seq,ind,sep,same")
     ap.add_argument("--shr-args", default="--shared-photons 1", help="flags of the shr variant (one string)")
     ap.add_argument("--window", type=int, default=4)
+    ap.add_argument("--seeds", type=int, default=1,
+                    help="render seq/ind/shr with seeds 1..N and sep with N seed sets (1000 + i + 100 k); errors are "
+                         "pooled over all frames and seeds, CPU seconds averaged per realisation")
     a = ap.parse_args()
     out = a.out
     os.makedirs(out, exist_ok=True)
@@ -91,30 +143,13 @@ def main():
             times["ref"] = cpu_run([TDPM, "render", a.scene, "-o", out + "/ref/f_####.exr", "--frame-range", rng,
                                     "--seed", "99", "--spp", str(4 * a.spp), "--photons", str(a.ref_mult * a.photons),
                                     "--global-photons", str(a.ref_mult * a.global_photons)] + common + own)
-        if "seq" in variants:
-            times["seq"] = cpu_run([TDPM, "render", a.scene, "-o", out + "/seq/f_####.exr", "--frame-range", rng]
-                                   + seq_args + win + own)
-        if "shr" in variants:
-            times["shr"] = cpu_run([TDPM, "render", a.scene, "-o", out + "/shr/f_####.exr", "--frame-range", rng]
-                                   + seq_args + win + a.shr_args.split())
-        if "ind" in variants:
-            times["ind"] = cpu_run([TDPM, "render", a.scene, "-o", out + "/ind/f_####.exr", "--frame-range", rng,
-                                    "--independent-frames"] + seq_args + win + own)
         subprocess.run([sys.executable, os.path.join(ROOT, "bench", "animation", "single_frames.py"), a.scene, single,
                         str(a.first), str(a.last)], check=True)
-        for variant, seed in (("sep", None), ("same", 1)):
-            if variant not in variants:
-                continue
-            os.makedirs(out + "/" + variant, exist_ok=True)
-            total = 0.0
-            for i in frames:
-                s = str(1000 + i) if seed is None else str(seed)
-                total += cpu_run([TDPM, "render", "%s/frame_%04d.json" % (single, i), "-o",
-                                  "%s/%s/f_%04d.exr" % (out, variant, i), "--seed", s, "--fixed-budget"] + seq_args)
-            times[variant] = total
+        for k in range(a.seeds):
+            render_variants(a, k, variants, rng, frames, seq_args, win, own, single, out, times)
         json.dump(times, open(tfile, "w"))
-    print("scene %s frames %s at %s, spp %d, photons %d + %d global per frame; reference x%d photons, x4 spp"
-          % (a.scene, rng, a.res, a.spp, a.photons, a.global_photons, a.ref_mult))
+    print("scene %s frames %s at %s, spp %d, photons %d + %d global per frame; reference x%d photons, x4 spp; %d seed(s)"
+          % (a.scene, rng, a.res, a.spp, a.photons, a.global_photons, a.ref_mult, a.seeds))
     for crop in a.crop:
         ref_flicker = [compare("%s/ref/f_%04d.exr" % (out, i + 1), "%s/ref/f_%04d.exr" % (out, i), crop)["rmse"]["overall"]
                        for i in frames[:-1]]
@@ -123,16 +158,20 @@ def main():
                                                        "flicker", "thr mean", "thr med"))
         rows = {}
         for v in ("seq", "ind", "sep", "same", "shr"):
-            if not os.path.exists("%s/%s/f_%04d.exr" % (out, v, frames[-1])):
+            ks = [k for k in range(a.seeds) if os.path.exists("%s/f_%04d.exr" % (vdir(out, v, k), frames[-1]))]
+            if not ks:
                 continue
-            rel = [compare("%s/%s/f_%04d.exr" % (out, v, i), "%s/ref/f_%04d.exr" % (out, i))["rel_mse"]["overall"]
-                   for i in frames]
-            relc = [compare("%s/%s/f_%04d.exr" % (out, v, i), "%s/ref/f_%04d.exr" % (out, i), crop)["rel_mse"]["overall"]
-                    for i in frames]
-            fl = [compare("%s/%s/f_%04d.exr" % (out, v, i + 1), "%s/%s/f_%04d.exr" % (out, v, i), crop)["rmse"]["overall"]
-                  for i in frames[:-1]]
+            rel, relc, fl = [], [], []
+            for k in ks:
+                d = vdir(out, v, k)
+                rel += [compare("%s/f_%04d.exr" % (d, i), "%s/ref/f_%04d.exr" % (out, i))["rel_mse"]["overall"]
+                        for i in frames]
+                relc += [compare("%s/f_%04d.exr" % (d, i), "%s/ref/f_%04d.exr" % (out, i), crop)["rel_mse"]["overall"]
+                         for i in frames]
+                fl += [compare("%s/f_%04d.exr" % (d, i + 1), "%s/f_%04d.exr" % (d, i), crop)["rmse"]["overall"]
+                       for i in frames[:-1]]
             med = sorted(rel)[len(rel) // 2]
-            rows[v] = (times.get(v, float("nan")), sum(rel) / len(rel), med, sum(relc) / len(relc), sum(fl) / len(fl))
+            rows[v] = (mean_time(times, v, a.seeds), sum(rel) / len(rel), med, sum(relc) / len(relc), sum(fl) / len(fl))
         for v, (t, mean, med, crop_err, fl) in rows.items():
             thr = lambda i: (rows["sep"][0] * rows["sep"][i]) / (t * (mean if i == 1 else med)) if "sep" in rows else float("nan")
             print("%-5s %10.2f %12.6f %14.6f %12.6f %12.5f %10.3f %10.3f" % (v, t, mean, med, crop_err, fl, thr(1), thr(2)))

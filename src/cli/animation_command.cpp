@@ -249,6 +249,9 @@ void printAnimationSummary(const RenderArgs& a, const RenderOptions& opt, const 
     std::fprintf(stderr, "  peak resident memory: %llu bytes\n", static_cast<unsigned long long>(peakRss));
     std::fprintf(stderr, "  peak photons held: %zu\n", stats.peakHeldPhotons);
     std::fprintf(stderr, "  photon pass: %.3f s\n", stats.photonSeconds);
+    if (!opt.progressive)
+      std::fprintf(stderr, "    of it: shared sets (with their pilots) %.3f s, frames' segments %.3f s, frame maps and trees %.3f s\n",
+                   stats.sharedSeconds, stats.segmentSeconds, stats.mapSeconds);
     if (stats.segmentPaths > 0)
       std::fprintf(stderr, "  frames' own segments: %llu paths, %zu photons; of them the pads: %llu paths (%.1f%%), %zu photons (%.1f%%)\n",
                    static_cast<unsigned long long>(stats.segmentPaths), stats.segmentPhotons,

@@ -273,6 +273,7 @@ class SegmentTimeline {
 
   // Trace the segments frames [w0, w1] need that are not held yet.
   void traceWindow(int w0, int w1) {
+    Timer timer;
     for (size_t k = 0; k + 1 < cuts_.size(); ++k) {
       int64_t lo = cuts_[k], hi = cuts_[k + 1];
       if (hi <= grid_.mapLo(w0) || lo >= grid_.mapHi(w1) || held_.count(lo)) continue;
@@ -282,6 +283,7 @@ class SegmentTimeline {
       held_.emplace(lo, traceSegment(lo, hi));
       ++stats_.segmentsTraced;
     }
+    stats_.segmentSeconds += timer.seconds();
   }
 
   // Free what no frame after `frame` needs.
@@ -298,6 +300,7 @@ class SegmentTimeline {
   void enterBlock(int frame) {
     const int block = frame / ao_.window;
     if (shared_.block == block) return;
+    Timer timer;
     held_.clear();
     shared_ = SharedSet{};
     shared_.block = block;
@@ -336,6 +339,7 @@ class SegmentTimeline {
       shared_.stores[kind] = std::move(r.store);
     }
     ++stats_.sharedSets;
+    stats_.sharedSeconds += timer.seconds();
   }
   const SharedSet* shared() const { return shared_.block >= 0 ? &shared_ : nullptr; }
 
@@ -469,6 +473,7 @@ void renderTimelineFrame(const Scene& scene, const scene::AnimationDesc& anim, c
       heldNow += maps[k]->store.size() + maps[k]->store3.size();
     }
     stats.photonSeconds += mapTimer.seconds();
+    stats.mapSeconds += mapTimer.seconds();
   }
   stats.peakHeldPhotons = std::max(stats.peakHeldPhotons, heldNow);
   RenderStats st;

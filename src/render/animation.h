@@ -63,6 +63,9 @@ struct AnimationOptions {
 
 struct AnimationStats {
   double photonSeconds = 0;                   // tracing, and building frame maps
+  // Its parts (--stats): the blocks' pilots and shared sets, the frames'
+  // own segments, and the frames' maps (copies and kd-trees).
+  double sharedSeconds = 0, segmentSeconds = 0, mapSeconds = 0;
   PerMap<MapStats> maps;                      // stored and emitted per map kind
   uint64_t segmentsTraced = 0;
   uint64_t sharedSets = 0;                    // blocks whose time-invariant photons were traced
