@@ -2,6 +2,7 @@
 // maps: trace each kind, then build its tree(s).
 #include "render/photon_map.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/timer.h"
@@ -24,7 +25,12 @@ photon::TraceSettings traceSettingsFor(const RenderOptions& opt, MapKind kind, s
   ts.kind = kind;
   ts.storedWanted = wanted;
   ts.seed = seed;
-  ts.maxBounces = opt.maxDepth;
+  // A volume photon stored at its (b+1)-th scattering event is read along
+  // an eye segment, where it closes a path of b + 1 scattering vertices:
+  // max_depth D keeps events b < D, as the volumetric path tracer's D
+  // vertices (max_depth 1: single scattering in both). Surface maps keep
+  // their bounce count.
+  ts.maxBounces = kind == MapKind::Volume ? std::max(0, opt.maxDepth - 1) : opt.maxDepth;
   ts.sampler = opt.sampler;
   return ts;
 }
