@@ -22,7 +22,14 @@
 //     at any later glass vertex (the split's recursion would carry the
 //     medium and the media streams; left for later, docs/media.md);
 //   - emission, background and environment are seen attenuated.
-// Progressive passes (Fixed volume kernels) are refused by renderer.cpp.
+// Progressive passes (fixedKernels): the pass's volume map is a Fixed beam
+// map (render/progressive.cpp), every photon the pass's disc radius and
+// time window, so the same beamRadiance reads it; the skip rule is the
+// surfaces' one again: the pass's window where the time-dependent estimate
+// applies, the whole shutter on the same discs elsewhere (kTimeless). Each
+// pass's photons carry energies for that pass's emitted count, so a pass's
+// estimate stands alone and renderProgressive averages the passes as it
+// does the surface estimates.
 #include <cmath>
 #include <limits>
 #include <optional>

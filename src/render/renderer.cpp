@@ -438,9 +438,10 @@ void checkMediaSupport(const Scene& scene, const RenderOptions& opt, bool stillI
     throw Error("the scene has participating media, which need -m pathtrace, time or standard in this version" +
                 std::string(stillImage ? "" : " (animations and frames: pathtrace only)") + "; method '" +
                 std::string(renderMethodName(opt.method)) + "' would render it without them");
-  if (opt.progressive)
-    throw Error("the scene has participating media: progressive rendering does not support them in this version; "
-                "render with -m pathtrace, time or standard without --progressive");
+  // Progressive time / standard: fresh volume photons per pass, Fixed beam
+  // kernels shrinking per pass (render/progressive.cpp, the eye side in
+  // render/photon_integrator_media.cpp); the method check above already
+  // refuses progressive accumulation.
 }
 
 // One level: the memory check, the method's render, the gather.
