@@ -226,6 +226,29 @@ TEST_CASE("mpi: 2 ranks path-trace bit-identical to one process") { checkSameIma
 // threads a rank, every thread takes tiles from it (MPI_THREAD_SERIALIZED
 // behind the counter's mutex), and which rank rendered which tile differs
 // from run to run; the image must not.
+// Participating media: the ranks trace shares of the volume photons too and
+// build the same beam map; fixed budget and progressive passes.
+TEST_CASE("mpi: 2 ranks render time in fog bit-identical to one process, fixed budget and progressive") {
+  std::string dir = test::makeTempDir();
+  const std::string base = "render '" + std::string(TDPM_SOURCE_DIR) +
+                           "/scenes/fog-airlight.json' -m time --resolution 32x24 --spp 2 --volume-photons 8000 -q ";
+  for (const std::string& mode : {std::string("--fixed-budget"), std::string("--progressive --passes 3")}) {
+    CommandResult one = test::runTdpm(base + mode + " --seed 7 -t 2 -o " + dir + "/one.exr");
+    REQUIRE_MESSAGE(one.exitCode == 0, one.output);
+    CommandResult two = runMpi(2, "", base + mode + " --seed 7 -t 1 -o " + dir + "/two.exr");
+    REQUIRE_MESSAGE(two.exitCode == 0, two.output);
+    image::ExrFile a = image::readExr(dir + "/one.exr"), b = image::readExr(dir + "/two.exr");
+    CHECK_MESSAGE(sameBits(a, b), mode << ": 2 ranks differ from one process");
+    double mean = 0;
+    for (const Rgb& c : a.color.pixels) mean += c.g / double(a.color.pixels.size());
+    CHECK_MESSAGE(mean > 0, mode << ": the fog is black");  // the volume map was read
+    CommandResult other = test::runTdpm(base + mode + " --seed 8 -t 2 -o " + dir + "/other.exr");
+    REQUIRE(other.exitCode == 0);
+    CHECK_FALSE(sameBits(a, image::readExr(dir + "/other.exr")));
+  }
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
 TEST_CASE("mpi: 2 ranks x 2 threads take tiles from the shared queue; time and pathtrace bit-identical") {
   checkSameImage("time", "", 2, 2);
   checkSameImage("pathtrace", "", 2, 2);

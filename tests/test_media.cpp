@@ -517,13 +517,16 @@ TEST_CASE("media: interface surfaces are invisible, with and without media") {
   CHECK(test::imageSum(test::renderOnce(d, o)) < 0.9 * test::imageSum(plain));
 }
 
-TEST_CASE("media: other methods refuse a scene with media instead of rendering without them") {
+TEST_CASE("media: progressive accumulation refuses a scene with media instead of rendering without them") {
   auto d = airlightScene(1, 0.1f, 0.1f, 1, 1, 3);
-  // time and standard render media (tests/test_media_photon_methods.cpp).
-  for (RenderMethod m : {RenderMethod::Static, RenderMethod::Accumulation}) {
-    auto o = test::smallRenderOptions(m, 1, 2, 1);
+  // time, standard, static and accumulation render media
+  // (tests/test_media_photon_methods.cpp); progressive accumulation not.
+  {
+    auto o = test::smallRenderOptions(RenderMethod::Accumulation, 1, 2, 1);
+    o.progressive = true;
     std::string e = test::errorMessageOf([&] { test::renderOnce(d, o); });
     CHECK(contains(e, "participating media, which need -m pathtrace, time or standard"));
+    CHECK(contains(e, "method 'accumulation' with --progressive"));
   }
   auto o = test::smallRenderOptions(RenderMethod::PathTrace, 1, 2, 1);
   o.progressive = true;
@@ -545,7 +548,7 @@ TEST_CASE("media: bad media input on the command line: located error, nothing wr
         "s.json:1: objects[0].medium: an interior medium needs a closed shape");
   check(sceneWith(kFog, "[]", R"("exterior_medium": "mist")"), "", "exterior_medium: unknown medium \"mist\"");
   check(sceneWith(R"("fog": {"type": "homogeneous", "sigma_a": 1, "sigma_s": 1, "g": 2})"), "", "media.fog.g:");
-  check(sceneWith(kFog, "[]", R"("exterior_medium": "fog")"), "-m static --resolution 4x4",
+  check(sceneWith(kFog, "[]", R"("exterior_medium": "fog")"), "-m accumulation --progressive --resolution 4x4",
         "need -m pathtrace, time or standard");
 }
 

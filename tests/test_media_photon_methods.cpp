@@ -273,7 +273,7 @@ TEST_CASE("media photon methods: direct light through a fog slab is exp(-sigma_t
   CHECK(dv.g == doctest::Approx(0.5f / kPi * 100.0f / (4 * kPi) / 9.0f * cosTheta).epsilon(1e-3));
 }
 
-TEST_CASE("media photon methods: time and standard render a fog scene near pathtrace; other methods refuse it") {
+TEST_CASE("media photon methods: time and standard render a fog scene near pathtrace; progressive accumulation refuses it") {
   const float I = 10, sa = 0.05f, ss = 0.25f, x0 = 2, h = 0.7f, D = 5;
   auto d = airlightScene(I, sa, ss, x0, h, D);
   d.materials[0] = test::diffuse(Rgb(0.5f));
@@ -288,16 +288,6 @@ TEST_CASE("media photon methods: time and standard render a fog scene near patht
     INFO(std::string(renderMethodName(m)) << " " << v << " pathtrace " << pt);
     CHECK(v == doctest::Approx(pt).epsilon(0.08));
   }
-  for (RenderMethod m : {RenderMethod::Static, RenderMethod::Accumulation}) {
-    auto o = test::smallRenderOptions(m, 1, 2, 1);
-    std::string e;
-    try {
-      test::renderOnce(d, o);
-    } catch (const std::exception& ex) {
-      e = ex.what();
-    }
-    CHECK(e.find("participating media, which need -m pathtrace, time or standard") != std::string::npos);
-  }
   // Progressive accumulation is refused with the method (progressive time
   // and standard render: tests/test_media_progressive.cpp).
   auto o = test::smallRenderOptions(RenderMethod::Accumulation, 1, 2, 1);
@@ -309,4 +299,44 @@ TEST_CASE("media photon methods: time and standard render a fog scene near patht
     e = ex.what();
   }
   CHECK(e.find("participating media, which need -m pathtrace, time or standard") != std::string::npos);
+}
+
+TEST_CASE("media photon methods: static and accumulation in fog with a moving light equal the frozen scenes' path traces") {
+  // The light moves along the eye ray from x0 = 0.5 to 4 (the airlight
+  // scene's black wall still at D = 5). `static` traces every photon at
+  // shutter open: its picture is the scene frozen at t = 0. `accumulation`
+  // with 4 frames is the mean of the scene frozen at t = 1/8, 3/8, 5/8, 7/8.
+  // Each frozen scene is path-traced (the volumetric path tracer).
+  const float I = 10, sa = 0.05f, ss = 0.25f, h = 0.7f, D = 5;
+  auto lightAt = [&](double t) { return Vec3f{h, 0, float(0.5 + 3.5 * t)}; };
+  auto moving = airlightScene(I, sa, ss, 0, h, D);
+  moving.lights[0].position = {0, 0, 0};
+  moving.lights[0].motion = test::translation(lightAt(0), lightAt(1));
+  auto frozenAt = [&](double t) {
+    auto d = airlightScene(I, sa, ss, 0, h, D);
+    d.lights[0].position = lightAt(t);
+    auto ref = test::smallRenderOptions(RenderMethod::PathTrace, 20000, 1, 5);
+    return double(test::renderOnce(d, ref).color[0].g);
+  };
+  const double frozen0 = frozenAt(0);
+  double frozenMean = 0;
+  for (int f = 0; f < 4; ++f) frozenMean += frozenAt((f + 0.5) / 4) / 4;
+  // The two pictures must differ enough for the checks to tell them apart.
+  REQUIRE(std::fabs(frozen0 - frozenMean) > 0.15 * frozenMean);
+  for (RenderMethod m : {RenderMethod::Static, RenderMethod::Accumulation}) {
+    std::vector<double> runs;
+    for (uint64_t seed = 1; seed <= 6; ++seed) {
+      auto o = test::smallRenderOptions(m, 16, 1, seed);
+      o.frames = 4;
+      o.volumePhotons = 40000;
+      o.causticPhotons = o.globalPhotons = 0;
+      o.gatherRays = 0;
+      runs.push_back(test::renderOnce(moving, o).color[0].g);
+    }
+    MeanError me = overRuns(runs);
+    const double expected = m == RenderMethod::Static ? frozen0 : frozenMean;
+    INFO(std::string(renderMethodName(m)) << ": " << me.mean << " +- " << me.error << ", frozen at 0 " << frozen0
+                                          << ", mean of 4 frozen frames " << frozenMean);
+    CHECK(std::fabs(me.mean - expected) < 4 * me.error + 0.04 * expected);
+  }
 }

@@ -87,6 +87,7 @@ Rgb PhotonIntegrator::mediumSegment(Vec3f o, Vec3f d, float tEnd, int32_t medium
                                   : estimate::beamRadiance<true>(map, *ts.beams, seg, t, phase, tr, &report);
     }
     ++ts.counts.estimates[MapKind::Volume];
+    ++(timeDependent ? ts.counts.timeDependent : ts.counts.standard);  // --stats' time / standard split
     ts.counts.few[MapKind::Volume] += report.summed < estimate::kFewPhotons;
     L = beta * inscattered;
   }

@@ -699,6 +699,7 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
     throw Error("--progressive works with the methods time, accumulation and standard, not '" +
                 std::string(renderMethodName(opt.method)) + "'");
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
+  checkMediaSupport(scene, opt, true);  // the CLI and resume come here, not through render()
   // One pass's memory, as a fixed-budget render of the same photon counts
   // (a fixed-budget accumulation would split them over its frames: a pass
   // holds them all, as standard does).

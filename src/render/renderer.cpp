@@ -433,15 +433,22 @@ void gatherFilm(dist::Comm& comm, TileOwners& owners, RenderStats& st, Film& fil
 
 void checkMediaSupport(const Scene& scene, const RenderOptions& opt, bool stillImage) {
   if (!scene.hasMedia()) return;
+  // Still images: every method. static and accumulation trace their volume
+  // photons at fixed instants (shutter open; each frame's own) and read them
+  // with the standard beam estimate, as their surface maps. Progressive
+  // time / standard: fresh volume photons per pass, Fixed beam kernels
+  // shrinking per pass (render/progressive.cpp, the eye side in
+  // render/photon_integrator_media.cpp). Progressive accumulation (a pass
+  // at one instant with Fixed volume kernels) is not checked in media yet.
   const bool photonMethod = opt.method == RenderMethod::Time || opt.method == RenderMethod::Standard;
-  if (opt.method != RenderMethod::PathTrace && !(stillImage && photonMethod))
+  const bool fixedInstants = opt.method == RenderMethod::Static || opt.method == RenderMethod::Accumulation;
+  const bool renders = opt.method == RenderMethod::PathTrace ||
+                       (stillImage && (photonMethod || (fixedInstants && !opt.progressive)));
+  if (!renders)
     throw Error("the scene has participating media, which need -m pathtrace, time or standard in this version" +
-                std::string(stillImage ? "" : " (animations and frames: pathtrace only)") + "; method '" +
-                std::string(renderMethodName(opt.method)) + "' would render it without them");
-  // Progressive time / standard: fresh volume photons per pass, Fixed beam
-  // kernels shrinking per pass (render/progressive.cpp, the eye side in
-  // render/photon_integrator_media.cpp); the method check above already
-  // refuses progressive accumulation.
+                std::string(stillImage ? " (static and accumulation: fixed budget only)" : " (animations and frames: pathtrace only)") +
+                "; method '" + std::string(renderMethodName(opt.method)) + "'" + (opt.progressive ? " with --progressive" : "") +
+                " would render it without them");
 }
 
 // One level: the memory check, the method's render, the gather.
@@ -449,11 +456,9 @@ Film render(const Scene& scene, const RenderOptions& opt, const Progress& progre
   TDPM_ASSERT(opt.spp >= 1 && opt.maxDepth >= 1, "invalid render options");
   checkMediaSupport(scene, opt, true);
   const RenderMethodTraits& method = renderMethodTraits(opt.method);
-  // Each rank would trace its own volume map the way the surface maps are
-  // shared; that path is not checked with media yet.
-  if (scene.hasMedia() && comm.distributed() && method.photonMaps)
-    throw Error("the scene has participating media: distributed (MPI) photon-map renders do not support them in this "
-                "version; render on one process or with -m pathtrace");
+  // Under mpirun the ranks trace shares of the volume photons as of the
+  // surface photons (photon/tracer.cpp's queued batches, gathered in rank
+  // order), and every rank builds the same beam map from the same store.
   if (opt.progressive) {  // render/progressive.h, from pass 0, on the same ranks
     ProgressiveState state;
     return renderProgressive(scene, opt, state, progress, st, comm);

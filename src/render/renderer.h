@@ -42,9 +42,9 @@ std::vector<std::string> sceneWarnings(const Scene& scene);
 
 // A located error when the scene has participating media and the options
 // ask for what does not render them: a still image (stillImage, render())
-// takes pathtrace, time or standard (the photon methods' eye side in media:
-// render/photon_integrator_media.cpp); animations and frames pathtrace only;
-// progressive rendering none (no progressive volume maps yet).
+// takes every method (the photon methods' eye side in media:
+// render/photon_integrator_media.cpp), progressive time and standard, not
+// progressive accumulation; animations and frames pathtrace only.
 // render(), renderFrame() and renderAnimation() call it first.
 void checkMediaSupport(const Scene& scene, const RenderOptions& options, bool stillImage = false);
 
