@@ -9,6 +9,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -338,5 +339,55 @@ TEST_CASE("media photon methods: static and accumulation in fog with a moving li
     INFO(std::string(renderMethodName(m)) << ": " << me.mean << " +- " << me.error << ", frozen at 0 " << frozen0
                                           << ", mean of 4 frozen frames " << frozenMean);
     CHECK(std::fabs(me.mean - expected) < 4 * me.error + 0.04 * expected);
+  }
+}
+
+TEST_CASE("media photon methods: a sun and a sky into exterior fog reach the scene through the media's world sphere") {
+  // A grey floor in fog everywhere, lit by a sun or a constant sky. The fog
+  // ends at the sphere around the bounds and the camera (Scene::mediaExit):
+  // before, a shadow ray to the sun crossed infinite fog (pathtrace black)
+  // while the sun's photons started on their disc.
+  const float sigmaT = 0.1f;
+  auto d = test::emptyScene(24, 16);
+  d.camera.position = {0, 1, 3};
+  d.camera.target = {0, 0, 0};
+  d.camera.fovDegrees = 50;
+  d.materials.push_back(test::diffuse(Rgb(0.5f)));
+  d.objects.push_back(test::quad({4, 4}, {0, 0, 0}, 0));
+  d.media.push_back(fog(Rgb(0.02f), Rgb(sigmaT - 0.02f)));
+  d.exteriorMedium = d.camera.medium = 0;
+  for (bool sky : {false, true}) {
+    scene::LightDesc l;
+    if (sky) {
+      l.type = scene::LightDesc::Type::Environment;
+      l.radiance = Rgb(0.5f);
+    } else {
+      l.type = scene::LightDesc::Type::Directional;
+      l.direction = normalize(Vec3f{0.3f, -1, -0.2f});
+      l.power = Rgb(3.0f);
+    }
+    l.medium = 0;
+    d.lights = {l};
+    auto s = Scene::build(d);
+    REQUIRE(s->hasMedia());
+    // The sphere holds the floor and the camera; mediaExit is its far root.
+    CHECK(length(Vec3f{2, 0, 2} - s->mediaWorldCentre) < s->mediaWorldRadius);
+    CHECK(length(Vec3f{0, 1, 3} - s->mediaWorldCentre) < s->mediaWorldRadius);
+    const Vec3f p{0.2f, 0.0f, -0.3f}, up = normalize(Vec3f{-0.3f, 1, 0.2f});
+    const float exit = s->mediaExit(p, up);
+    CHECK(length(p + up * exit - s->mediaWorldCentre) == doctest::Approx(s->mediaWorldRadius).epsilon(1e-4));
+    Rng rng(1);
+    Rgb T = transmittanceTo(*s, s->spawnOrigin(p, {0, 1, 0}, up), up, std::numeric_limits<float>::infinity(), 0.5f, 0, rng);
+    CHECK(T.g == doctest::Approx(std::exp(-sigmaT * exit)).epsilon(1e-3));
+    CHECK(T.g > 0.5f);
+    // pathtrace and time agree on the whole picture.
+    auto pt = test::smallRenderOptions(RenderMethod::PathTrace, 256, 4, 2);
+    auto tm = test::smallRenderOptions(RenderMethod::Time, 16, 4, 2);
+    tm.volumePhotons = 100000;
+    tm.globalPhotons = 100000;
+    double a = test::imageSum(test::renderOnce(d, pt)), b = test::imageSum(test::renderOnce(d, tm));
+    INFO((sky ? "sky" : "sun") << ": pathtrace " << a << ", time " << b);
+    CHECK(a > 0);
+    CHECK(b == doctest::Approx(a).epsilon(0.05));
   }
 }

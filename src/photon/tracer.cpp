@@ -501,6 +501,11 @@ struct Tracer {
     // Media: the walk of photon/tracer_media.h (a scene without media never
     // takes it, so its paths are exactly the loop below).
     if (scene.hasMedia()) {
+      // A sun's or the sky's photon starts on a disc outside the scene: its
+      // media begin where it enters their world (Scene::mediaEntry), as a
+      // shadow ray toward that light ends there.
+      if (light.type == Light::Type::Directional || light.type == Light::Type::Environment)
+        origin = origin + dir * scene.mediaEntry(origin, dir);
       MediaPath mp{origin, dir, power, time01, time, scene.lightMedia[li], invariant, pathIndex};
       return rays + walkPhotonInMedia(scene, settings, mp, rng, energyScale, out, exits);
     }

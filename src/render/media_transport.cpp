@@ -15,7 +15,10 @@ Rgb transmittanceTo(const Scene& s, Vec3f o, Vec3f d, float tMax, float time01, 
     Hit hit;
     bool found = tMax > 0 && s.intersect(o, d, tMax, time01, hit);
     if (medium >= 0) {
-      T = T * media::transmittance(s.media[size_t(medium)], o, d, found ? hit.t : std::max(tMax, 0.0f), time01, rng);
+      // A shadow ray to a sun or the sky crosses the media up to where
+      // their world ends (Scene::mediaExit), as the light's photons do.
+      const float end = found ? hit.t : std::isinf(tMax) ? s.mediaExit(o, d) : std::max(tMax, 0.0f);
+      T = T * media::transmittance(s.media[size_t(medium)], o, d, end, time01, rng);
       if (T.isBlack()) return T;
     }
     if (!found) return T;

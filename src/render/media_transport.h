@@ -41,7 +41,8 @@ Rgb transmittanceTo(const Scene& s, Vec3f o, Vec3f d, float tMax, float time01, 
 
 // The eye side's ray through interfaces: from o along unit d in `medium`,
 // calls segment(o_k, tEnd_k, medium_k) for every piece of the ray in a
-// medium (medium_k >= 0; tEnd_k infinite when the ray escapes), passing
+// medium (medium_k >= 0; tEnd_k where the media's world ends when the ray
+// escapes, Scene::mediaExit), passing
 // interface surfaces (the medium changes, nothing else), until the first
 // real surface or emitter (true, `hit` filled, o and medium those of the
 // last piece) or escape (false). `segment` returns false to stop the walk
@@ -53,7 +54,7 @@ bool intersectThroughInterfaces(const Scene& s, Vec3f& o, Vec3f d, float time01,
   stopped = false;
   for (int crossing = 0; crossing < kMaxMediumCrossings; ++crossing) {
     bool found = s.intersect(o, d, kInf, time01, hit);
-    if (medium >= 0 && !segment(o, found ? hit.t : kInf, medium)) {
+    if (medium >= 0 && !segment(o, found ? hit.t : s.mediaExit(o, d), medium)) {
       stopped = true;
       return false;
     }

@@ -120,7 +120,7 @@ Rgb PathTracer::traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& sample
     bool found = scene_.intersect(origin, dir, kInf, time01, hit);
     if (medium >= 0) {
       const media::Medium& med = scene_.media[size_t(medium)];
-      media::FreeFlight ff = media::sampleFreeFlight(med, origin, dir, found ? hit.t : kInf, time01, rng, beta);
+      media::FreeFlight ff = media::sampleFreeFlight(med, origin, dir, found ? hit.t : scene_.mediaExit(origin, dir), time01, rng, beta);
       if (ff.event == media::FreeFlight::Event::Absorb || beta.isBlack() || !isFinite(beta)) break;
       if (ff.event == media::FreeFlight::Event::Scatter) {
         // ---- a medium vertex ----

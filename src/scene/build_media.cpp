@@ -50,6 +50,16 @@ void Scene::buildMedia(const scene::SceneDescription& desc) {
     mi.inside = instance(mi.inside, int32_t(i));
     mi.outside = instance(mi.outside, -1);
   }
+  // The media's world: the scene's bounds (every object and emitter over
+  // the shutter) and every camera position, in one sphere a little larger
+  // than their box's (the directional and sky photons' disc, light.cpp,
+  // has the bounds' sphere; this one also holds a camera standing outside
+  // the geometry, in the fog it looks through).
+  Bounds3f world = bounds;
+  world.extend(desc.camera.position);
+  for (const scene::CameraKeyframe& k : desc.camera.motion) world.extend(k.position);
+  mediaWorldCentre = world.center();
+  mediaWorldRadius = std::max(1e-6f, 0.5f * length(world.diagonal()) * 1.01f);
 }
 
 }  // namespace tdpm

@@ -4,6 +4,7 @@
 // Built once per render from a validated SceneDescription; read-only after.
 #pragma once
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -166,6 +167,31 @@ class Scene {
   int32_t cameraMedium = -1;          // index into media, -1 vacuum
   std::vector<int32_t> lightMedia;    // per light: the medium it emits into
   bool hasMedia() const { return !media.empty(); }
+  // Where media end: the exterior medium fills the sphere around the scene's
+  // bounds and the camera's positions (docs/media.md, "The media's world"),
+  // vacuum beyond, so that a sun or sky reaches the scene through a finite
+  // depth of fog, the same for shadow rays, escaping eye and path rays and
+  // the photons emitted from outside (scene/build_media.cpp).
+  Vec3f mediaWorldCentre{0, 0, 0};
+  float mediaWorldRadius = 0.0f;
+  // The distance along unit d from o to where the media's world ends (its
+  // sphere's far root; 0 when the line misses it or leaves it behind o):
+  // what a ray that escapes the scene's geometry crosses of a medium.
+  float mediaExit(Vec3f o, Vec3f d) const {
+    Vec3f oc = o - mediaWorldCentre;
+    float b = dot(oc, d), c = dot(oc, oc) - mediaWorldRadius * mediaWorldRadius;
+    float disc = b * b - c;
+    if (disc <= 0.0f) return 0.0f;
+    return std::max(0.0f, -b + std::sqrt(disc));
+  }
+  // The near root (negative when o is inside): where a ray from outside
+  // enters the media's world.
+  float mediaEntry(Vec3f o, Vec3f d) const {
+    Vec3f oc = o - mediaWorldCentre;
+    float b = dot(oc, d), c = dot(oc, oc) - mediaWorldRadius * mediaWorldRadius;
+    float disc = b * b - c;
+    return disc <= 0.0f ? 0.0f : -b - std::sqrt(disc);
+  }
 
  private:
   const Material& shadeTextured(const Material& m, const Hit& hit, std::optional<Material>& scratch) const;
