@@ -50,7 +50,7 @@ uint64_t walkPhotonInMedia(const Scene& scene, const TraceSettings& settings, co
     if (medium >= 0) {
       const media::Medium& med = scene.media[size_t(medium)];
       media::FreeFlight ff =
-          media::sampleFreeFlight(med, origin, dir, found ? hit.t : scene.mediaExit(origin, dir), path.time01, mediumRng, power);
+          media::sampleFreeFlight(med, origin, dir, found ? hit.t : kInf, path.time01, mediumRng, power);
       if (ff.event == media::FreeFlight::Event::Absorb || power.isBlack() || !isFinite(power)) return rays;
       if (ff.event == media::FreeFlight::Event::Scatter) {
         // ---- a medium vertex ----

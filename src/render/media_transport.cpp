@@ -8,6 +8,12 @@
 
 namespace tdpm {
 
+Rgb skyTransmittance(const Scene& s, const media::Medium& m, Vec3f o, Vec3f d, float time01, Rng& rng) {
+  const float exit = s.mediaExit(o, d);
+  if (!(exit > 0.0f)) return Rgb(0.0f);  // outside, the world behind or beside: no sky light comes along here
+  return media::transmittance(m, o, d, exit, time01, rng);
+}
+
 Rgb transmittanceTo(const Scene& s, Vec3f o, Vec3f d, float tMax, float time01, int32_t medium, Rng& rng) {
   Rgb T(1.0f);
   const Vec3f target = o + d * (std::isinf(tMax) ? 0.0f : tMax);
@@ -15,10 +21,8 @@ Rgb transmittanceTo(const Scene& s, Vec3f o, Vec3f d, float tMax, float time01, 
     Hit hit;
     bool found = tMax > 0 && s.intersect(o, d, tMax, time01, hit);
     if (medium >= 0) {
-      // A shadow ray to a sun or the sky crosses the media up to where
-      // their world ends (Scene::mediaExit), as the light's photons do.
-      const float end = found ? hit.t : std::isinf(tMax) ? s.mediaExit(o, d) : std::max(tMax, 0.0f);
-      T = T * media::transmittance(s.media[size_t(medium)], o, d, end, time01, rng);
+      if (!found && std::isinf(tMax)) return T * skyTransmittance(s, s.media[size_t(medium)], o, d, time01, rng);
+      T = T * media::transmittance(s.media[size_t(medium)], o, d, found ? hit.t : std::max(tMax, 0.0f), time01, rng);
       if (T.isBlack()) return T;
     }
     if (!found) return T;

@@ -33,6 +33,13 @@ Rng mediumRng(Stream& sampler) {
   return Rng(seed, 0x6d65646961ull);  // "media"
 }
 
+// The sky's (and a sun's) light seen from o along unit d through the medium
+// m the ray escapes in: infinite lights shine from the media's world sphere
+// inward (Scene::mediaExit, docs/media.md "Suns and skies"), so this is the
+// transmittance up to where the ray leaves that sphere, and zero when the
+// ray does not leave it outward ahead of o.
+Rgb skyTransmittance(const Scene& s, const media::Medium& m, Vec3f o, Vec3f d, float time01, Rng& rng);
+
 // Transmittance from o along unit d over [0, tMax] starting in `medium`:
 // the product over the media crossed (closed form in homogeneous media,
 // ratio tracking in grids: media/medium.h), through interface surfaces;
@@ -41,8 +48,8 @@ Rgb transmittanceTo(const Scene& s, Vec3f o, Vec3f d, float tMax, float time01, 
 
 // The eye side's ray through interfaces: from o along unit d in `medium`,
 // calls segment(o_k, tEnd_k, medium_k) for every piece of the ray in a
-// medium (medium_k >= 0; tEnd_k where the media's world ends when the ray
-// escapes, Scene::mediaExit), passing
+// medium (medium_k >= 0; tEnd_k infinite when the ray escapes: the sky it
+// then sees is attenuated up to the media's world, skyTransmittance), passing
 // interface surfaces (the medium changes, nothing else), until the first
 // real surface or emitter (true, `hit` filled, o and medium those of the
 // last piece) or escape (false). `segment` returns false to stop the walk
@@ -54,7 +61,7 @@ bool intersectThroughInterfaces(const Scene& s, Vec3f& o, Vec3f d, float time01,
   stopped = false;
   for (int crossing = 0; crossing < kMaxMediumCrossings; ++crossing) {
     bool found = s.intersect(o, d, kInf, time01, hit);
-    if (medium >= 0 && !segment(o, found ? hit.t : s.mediaExit(o, d), medium)) {
+    if (medium >= 0 && !segment(o, found ? hit.t : kInf, medium)) {
       stopped = true;
       return false;
     }

@@ -14,13 +14,6 @@ namespace tdpm {
 
 namespace {
 constexpr int kRouletteStartDepth = 3;
-// Diffuse vertices of an eye path that the caustic guide serves: the first
-// (a caustic seen) and the second (a caustic lighting what is seen). On
-// cube-caustic at 1024 spp (seeds 1, 2; docs/sampling.md) relMSE was 0.35
-// guiding the first only, 0.24 the first two, 0.23 all, and every guided
-// vertex near photons costs a k-NN (~2,100 instructions in the 196k-photon
-// guide of a 1024-spp render).
-constexpr int kGuidedDiffuseVertices = 2;
 }
 
 // Longer than 80 lines on purpose: it is one sample's path, the render's
@@ -28,7 +21,7 @@ constexpr int kGuidedDiffuseVertices = 2;
 // instead of passing through a call per vertex.
 template <class Stream>
 Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts) const {
-  if (scene_.hasMedia()) return traceMedia(origin, dir, time01, sampler);
+  if (scene_.hasMedia()) return traceMedia(origin, dir, time01, sampler, ts);
   Rgb L(0.0f), beta(1.0f);
   // Product of eta^2 over the refractions so far: the radiance scaling
   // 1/eta^2 a refraction puts into beta is undone for Russian roulette,

@@ -91,7 +91,10 @@ Rgb PhotonIntegrator::mediumSegment(Vec3f o, Vec3f d, float tEnd, int32_t medium
     ts.counts.few[MapKind::Volume] += report.summed < estimate::kFewPhotons;
     L = beta * inscattered;
   }
-  beta = beta * media::transmittance(m, o, d, tEnd, time01, rng);
+  // An escaping piece: the in-scattered light came from all of it (above),
+  // the sky after it only from the media's world (skyTransmittance).
+  beta = beta * (std::isinf(tEnd) ? skyTransmittance(scene_, m, o, d, time01, rng)
+                                  : media::transmittance(m, o, d, tEnd, time01, rng));
   return L;
 }
 

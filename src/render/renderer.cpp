@@ -348,9 +348,10 @@ void addEstimateCounts(RenderStats& st, const EstimateCounts& c) {
 // pathtrace: the caustic guide, then the adaptive passes.
 void renderPathTraced(const Scene& scene, const RenderOptions& opt, const SamplingPlan& plan, const Progress& progress,
                       RenderStats& st, Film& film) {
-  // The guide's photons know no media: the volumetric path tracer
-  // (render/volume_path.cpp) samples plainly.
-  CausticGuide guide = scene.hasMedia() ? CausticGuide{} : buildCausticGuide(scene, opt, progress, st);
+  // In media the guide's photons are traced through them (transmittance,
+  // scattering ends a caustic path) and the volumetric path tracer
+  // (render/volume_path.cpp) guides its surface vertices alike.
+  CausticGuide guide = buildCausticGuide(scene, opt, progress, st);
   PathTracer pt(scene, opt.maxDepth, &guide, opt.directOnly);
   renderPixels(scene, pt, plan, "render", progress, film);
   st.guideCellsFilled = guide.cacheFilled();

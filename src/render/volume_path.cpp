@@ -22,14 +22,19 @@
 // Differs from pbrt-v4: pbrt folds the free-flight and ratio-tracking
 // densities into its MIS weights (r_u, r_l) and uses the hero wavelength's
 // majorant; here spectral tracking keeps the weights per channel and MIS
-// directional (docs/media.md). No caustic guide (its photons know no media).
+// directional (docs/media.md). The caustic guide serves the first two
+// diffuse surface vertices as in path_tracer.cpp (its photons are traced
+// through the media, render/caustic_guide.h): the BSDF ray from the guided
+// mixture, its density in every MIS weight and undone for roulette.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "media/medium.h"
 #include "media/phase.h"
+#include "render/caustic_guide.h"
 #include "render/direct_light.h"
+#include "render/guided_sampling.h"
 #include "render/media_transport.h"
 #include "render/path_tracer.h"
 #include "scene/bsdf.h"
@@ -43,16 +48,22 @@ constexpr int kMaxCrossings = kMaxMediumCrossings;  // render/media_transport.h
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
 // What scatters at a path vertex: a phase function (surface == null) or
-// a surface's BSDF. f includes the BSDF's |cos|.
+// a surface's BSDF, sampled by the guide's mixture where `guide` is active.
+// f includes the BSDF's |cos|.
 struct Scatterer {
   const ShadingContext* surface = nullptr;
   Vec3f wo;
   float g = 0.0f;
+  const GuideCones* guide = nullptr;
   Rgb f(Vec3f wi) const {
     if (!surface) return Rgb(media::henyeyGreenstein(dot(wo, wi), g));
     return bsdfEval(*surface, wi) * std::fabs(dot(wi, surface->frame.n));
   }
-  float pdf(Vec3f wi) const { return surface ? bsdfPdf(*surface, wi) : media::henyeyGreenstein(dot(wo, wi), g); }
+  float pdf(Vec3f wi) const {
+    if (!surface) return media::henyeyGreenstein(dot(wo, wi), g);
+    float pb = bsdfPdf(*surface, wi);
+    return guide ? guide->pdf(pb, wi) : pb;
+  }
 };
 
 // Next-event estimation at point p (a medium point, or a surface hit with
@@ -92,8 +103,8 @@ Rgb nextEvent(const Scene& s, Vec3f p, const Hit* hit, const Scatterer& sc, int3
 // Russian roulette as render/path_tracer.cpp: only below weight 1, from
 // kRouletteStartDepth. False: the path ends.
 template <class Stream>
-bool survives(Rgb& beta, float etaScale, int depth, Stream& sampler) {
-  float rr = beta.maxComponent() * etaScale;
+bool survives(Rgb& beta, float etaScale, float guideScale, int depth, Stream& sampler) {
+  float rr = beta.maxComponent() * etaScale * guideScale;
   if (depth + 1 < kRouletteStartDepth || rr >= 1.0f) return true;
   if (sampler.get1D(dims::vertexGroup(depth, dims::kRoulette)) >= rr) return false;
   beta = beta / rr;
@@ -105,9 +116,13 @@ bool survives(Rgb& beta, float etaScale, int depth, Stream& sampler) {
 // Longer than 80 lines on purpose, as PathTracer::trace: one sample's path,
 // its throughput, MIS state and medium kept local to the loop.
 template <class Stream>
-Rgb PathTracer::traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& sampler) const {
+Rgb PathTracer::traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& sampler, ThreadState& ts) const {
   Rgb L(0.0f), beta(1.0f);
   float etaScale = 1.0f;   // as trace(): refraction's 1/eta^2 undone for roulette
+  float guideScale = 1.0f; // as trace(): the guide's p_mix / p_bsdf undone for roulette
+  int diffuseVertices = 0; // non-delta surface vertices so far (the guide serves the first two)
+  GuideCones& cones = ts.cones;
+  bool beyondWorld = false;  // the ray starts where it left the media's world: no sky ahead
   bool lastDelta = true;   // camera ray: full weight on emission
   float lastPdf = 0.0f;
   Vec3f lastP = origin;
@@ -118,9 +133,20 @@ Rgb PathTracer::traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& sample
   for (int crossings = 0; crossings < kMaxCrossings;) {
     Hit hit;
     bool found = scene_.intersect(origin, dir, kInf, time01, hit);
+    // An escaping ray in a medium meets the sky where it leaves the media's
+    // world (suns and skies shine from that sphere inward, docs/media.md),
+    // and the medium goes on beyond it without sky.
+    float tFlight = found ? hit.t : kInf;
+    bool skyAhead = !found;
+    if (medium >= 0 && !found) {
+      const float exit = beyondWorld ? 0.0f : scene_.mediaExit(origin, dir);
+      skyAhead = exit > 0.0f;
+      if (skyAhead) tFlight = exit;
+    }
+    beyondWorld = false;
     if (medium >= 0) {
       const media::Medium& med = scene_.media[size_t(medium)];
-      media::FreeFlight ff = media::sampleFreeFlight(med, origin, dir, found ? hit.t : scene_.mediaExit(origin, dir), time01, rng, beta);
+      media::FreeFlight ff = media::sampleFreeFlight(med, origin, dir, tFlight, time01, rng, beta);
       if (ff.event == media::FreeFlight::Event::Absorb || beta.isBlack() || !isFinite(beta)) break;
       if (ff.event == media::FreeFlight::Event::Scatter) {
         // ---- a medium vertex ----
@@ -136,15 +162,21 @@ Rgb PathTracer::traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& sample
         origin = p;
         dir = wi;
         if (directOnly_) lastDepth = std::min(lastDepth, depth + 1);
-        if (!survives(beta, etaScale, depth, sampler)) break;
+        if (!survives(beta, etaScale, guideScale, depth, sampler)) break;
         ++depth;
         continue;
       }
     }
     if (!found) {
-      L += beta * scene_.background;
-      if (!scene_.environmentLights.empty()) L += beta * environmentEmission(scene_, dir, lastPdf, 1, lastDelta);
-      break;
+      if (skyAhead) {
+        L += beta * scene_.background;
+        if (!scene_.environmentLights.empty()) L += beta * environmentEmission(scene_, dir, lastPdf, 1, lastDelta);
+      }
+      if (medium < 0 || std::isinf(tFlight)) break;
+      origin = origin + dir * tFlight;  // on into the medium beyond the sphere
+      beyondWorld = true;
+      ++crossings;
+      continue;
     }
     if (hit.isLight()) {  // ---- emission, attenuated by beta's media ----
       Rgb le;
@@ -165,13 +197,21 @@ Rgb PathTracer::traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& sample
     std::optional<Material> textured;
     ShadingContext ctx = scene_.shadingContext(mat, hit, -dir, textured);
     if (directOnly_ && !mat.isDeltaOnly()) lastDepth = std::min(lastDepth, depth + 1);
+    cones.clear();
+    if (guide_ && !mat.isDeltaOnly() && diffuseVertices < kGuidedDiffuseVertices)
+      guide_->conesAt(mat, hit.p, ctx.frame.n, cones);
     if (!mat.isDeltaOnly()) {
-      Scatterer sc{&ctx, -dir, 0.0f};
+      ++diffuseVertices;
+      Scatterer sc{&ctx, -dir, 0.0f, &cones};
       L += beta * nextEvent(scene_, hit.p, &hit, sc, medium, time01, sampler, depth, rng);
     }
     BsdfSample bs;
     Vec3f ub = sampler.get3D(dims::vertexGroup(depth, dims::kBsdf));
-    if (!bsdfSample(ctx, {ub.x, ub.y}, ub.z, Transport::Radiance, bs)) break;
+    if (!guidedBsdfSample(ctx, cones, {ub.x, ub.y}, ub.z, bs)) break;
+    if (cones.active()) {
+      float pb = bsdfPdf(ctx, bs.wi);
+      if (pb > 0.0f) guideScale *= bs.pdf / pb;
+    }
     beta *= bs.weight;
     if (beta.isBlack() || !isFinite(beta)) break;
     if (mat.transmits() && (dot(bs.wi, hit.n) < 0) != (dot(-dir, hit.n) < 0)) {
@@ -184,13 +224,13 @@ Rgb PathTracer::traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& sample
     lastP = hit.p;
     origin = scene_.spawnOrigin(hit.p, hit.n, bs.wi);
     dir = bs.wi;
-    if (!survives(beta, etaScale, depth, sampler)) break;
+    if (!survives(beta, etaScale, guideScale, depth, sampler)) break;
     ++depth;
   }
   return L;
 }
 
-template Rgb PathTracer::traceMedia<RandomStream>(Vec3f, Vec3f, float, RandomStream&) const;
-template Rgb PathTracer::traceMedia<SobolStream>(Vec3f, Vec3f, float, SobolStream&) const;
+template Rgb PathTracer::traceMedia<RandomStream>(Vec3f, Vec3f, float, RandomStream&, ThreadState&) const;
+template Rgb PathTracer::traceMedia<SobolStream>(Vec3f, Vec3f, float, SobolStream&, ThreadState&) const;
 
 }  // namespace tdpm
