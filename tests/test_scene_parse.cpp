@@ -434,7 +434,7 @@ TEST_CASE("scene parse: materials") {
   checkEdit([](Json& j) { j["materials"]["m"]["type"] = "lambert"; }, "materials.m.type",
             "unknown material type \"lambert\"; expected one of diffuse, mirror, dielectric, metal, plastic");
   checkEdit([](Json& j) { j["materials"]["m"]["roughness"] = 0.5; }, "materials.m.roughness",
-            "unknown key \"roughness\"; allowed keys: bump, color, normal_map, texture, type");
+            "unknown key \"roughness\"; allowed keys: bump, color, normal_map, sigma, texture, type");
   checkEdit([](Json& j) { j["materials"]["glass"]["ior"] = 0.9; }, "materials.glass.ior",
             "ior must be at least 1, got 0.9");
   checkEdit([](Json& j) { j["materials"]["m"] = {{"type", "metal"}, {"roughness", 0}}; }, "materials.m.roughness",

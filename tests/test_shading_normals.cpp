@@ -256,14 +256,23 @@ TEST_CASE("bump and normal map bad input: located errors") {
   std::string e = test::errorMessageOf([&] { pbrt::importPbrtFile(dir + "/bad.pbrt"); });
   has(e, "bad.pbrt:2");
   has(e, "gone.png");
-  // pbrt-v3's mix with a spectrum amount: refused, saying why.
+  // pbrt-v3's mix with a spectrum amount: mapped now (per channel, tests/test_textured_params.cpp),
+  // the two materials swapped (pbrt-v3's amount weights the first); a bad name is still located.
   test::writeFile(dir + "/mix.pbrt", "WorldBegin\nTexture \"c\" \"spectrum\" \"checkerboard\"\n"
                                      "MakeNamedMaterial \"a\" \"string type\" \"matte\"\n"
                                      "MakeNamedMaterial \"b\" \"string type\" \"mirror\"\n"
                                      "Material \"mix\" \"string materials\" [\"a\" \"b\"] "
                                      "\"texture amount\" \"c\"\nShape \"sphere\"\n");
-  std::string em = test::errorMessageOf([&] { pbrt::importPbrtFile(dir + "/mix.pbrt"); });
-  has(em, "mix.pbrt:5");
-  has(em, "per channel");
+  scene::SceneDescription mixed = pbrt::importPbrtFile(dir + "/mix.pbrt").scene;
+  const scene::MaterialDesc& m = mixed.materials.back();
+  CHECK(m.amountPerChannel);
+  CHECK(mixed.materials.at(m.mix[0]).type == scene::MaterialDesc::Type::Mirror);
+  test::writeFile(dir + "/mix2.pbrt", "WorldBegin\nMakeNamedMaterial \"a\" \"string type\" \"matte\"\n"
+                                      "MakeNamedMaterial \"b\" \"string type\" \"mirror\"\n"
+                                      "Material \"mix\" \"string materials\" [\"a\" \"b\"] "
+                                      "\"texture amount\" \"c\"\nShape \"sphere\"\n");
+  std::string em = test::errorMessageOf([&] { pbrt::importPbrtFile(dir + "/mix2.pbrt"); });
+  has(em, "mix2.pbrt:4");
+  has(em, "no texture named \"c\"");
   std::filesystem::remove_all(dir);
 }

@@ -654,7 +654,8 @@ TEST_CASE("textured material parameters: bad input gets located errors") {
   CHECK(contains(pbrtError(defs + "Material \"uber\" \"texture Ks\" \"f\"\n"), "is a float texture, but a reflectance needs a spectrum one"));
   CHECK(contains(pbrtError(defs + "Material \"uber\" \"texture opacity\" \"s\"\n"),
                  "a spectrum texture that varies is supported only on Kd of matte"));
-  CHECK(contains(pbrtError(defs + "Material \"coateddiffuse\" \"texture thickness\" \"f\"\n"),
-                 "a float texture that varies is supported only as a roughness or a mix's amount"));
+  CHECK(contains(pbrtError(defs + "Material \"coateddiffuse\" \"texture eta\" \"f\"\n"),
+                 "a float texture that varies is supported only as a roughness, a mix's amount, matte's sigma, "
+                 "a coating's thickness"));
   std::filesystem::remove_all(dir);
 }

@@ -58,9 +58,12 @@ double Importer::floatParam(const ParamSet& ps, const std::string& name, double 
   if (!p) return fallback;
   if (p->type == "texture") {
     p->used = true;
-    auto it = p->strings.size() == 1 ? textures_.find(p->strings[0]) : textures_.end();
-    if (it == textures_.end() || !it->second.isFloat) ps.fail(*p, "expected a float texture");
-    if (!it->second.constant) ps.fail(*p, "a float texture that varies is supported only as a roughness or a mix's amount; here only a constant one is");
+    if (p->strings.size() != 1) ps.fail(*p, "expected one texture name");
+    auto it = textures_.find(p->strings[0]);
+    if (it == textures_.end()) ps.fail(*p, "no texture named \"" + p->strings[0] + "\" has been defined");
+    if (!it->second.isFloat) ps.fail(*p, "expected a float texture");
+    if (!it->second.constant) ps.fail(*p, "a float texture that varies is supported only as a roughness, a mix's amount, matte's sigma, "
+                  "a coating's thickness, glass and uber eta, or a bump map; here only a constant one is");
     return it->second.value.r;
   }
   if (p->type == "spectrum") return spectrumFloat(ps, *p);  // v4: a spectral eta (a constant, a named glass, ...)
@@ -363,7 +366,19 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
     std::string key = type == "matte" ? "Kd" : "reflectance";
     m.albedo.color = textureParam(ps, key, Rgb(0.5f), &m.albedoTexture);
     checkReflectance(ps, key, m.albedo.color);
-    if (type == "matte" && floatParam(ps, "sigma", 0) != 0) failAt(at, label + ": Oren-Nayar roughness (sigma > 0) is not supported");
+    if (type == "matte") {
+      // pbrt-v3's matte: Oren-Nayar when sigma (degrees; a FloatTexture, per
+      // hit) is not 0, sigma clamped to [0, 90] as pbrt-v3 clamps it.
+      m.sigmaTexture = varyingTexture(ps, "sigma", true, "matte's sigma");
+      if (m.sigmaTexture < 0) {
+        double sigma = floatParam(ps, "sigma", 0);
+        if (!(sigma >= 0 && sigma <= 90)) {
+          note(at, label + ": sigma " + fmtNum(sigma) + " clamped to [0, 90] degrees, as pbrt-v3 does");
+          sigma = std::isnan(sigma) ? 0.0 : std::clamp(sigma, 0.0, 90.0);
+        }
+        m.sigma = float(sigma);
+      }
+    }
   } else if (type == "mirror") {
     m.type = T::Mirror;
     m.specular = textureParam(ps, "Kr", Rgb(0.9f), &m.specularTexture);
@@ -452,7 +467,9 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
       roughnessPre("conductor.", false, 0.0, &base, &m.baseRoughnessTexture);
       m.baseRoughness = float(std::max(base, 1e-3));
     }
-    m.thickness = float(floatParam(ps, "thickness", 0.01));
+    // A FloatTexture: per hit (Scene::shadedMaterial; build.cpp refuses values below 0).
+    m.thicknessTexture = varyingTexture(ps, "thickness", true, "a coating's thickness");
+    if (m.thicknessTexture < 0) m.thickness = float(floatParam(ps, "thickness", 0.01));
     if (!(m.thickness >= 0)) failAt(at, label + ": thickness must not be negative");
     Rgb albedo = color(ps, "albedo", Rgb(0.0f));
     if (!albedo.isBlack()) failAt(at, label + ": a coating with a scattering albedo is not supported");
@@ -473,17 +490,27 @@ MaterialSlot Importer::makeMaterial(const std::string& type, const ParamSet& ps,
       slot.mixSlots[i] = it->second;
     }
     m.type = T::Mix;
-    // pbrt-v4's amount is a FloatTexture: per hit (Scene::materialAt); a
-    // value outside [0, 1] there picks one component, as in pbrt.
-    if (const Param* a = ps.find("amount"); a && a->type == "texture" && a->strings.size() == 1) {
-      auto it = textures_.find(a->strings[0]);
-      if (it != textures_.end() && !it->second.isFloat && !it->second.constant)
-        ps.fail(*a, "a spectrum (RGB) amount blends the two BSDFs per channel (pbrt-v3), which tdpm's mix, one of "
-                    "the two materials per hit, cannot do; a float texture is supported");
+    // pbrt-v3's amount is a Spectrum (an rgb / spectrum value or texture):
+    // its MixMaterial scales the first material's BSDF by amount and the
+    // second's by 1 - amount, per channel. tdpm's per-channel mix weights
+    // its second material by amount: the two are swapped.
+    const Param* a = ps.find("amount");
+    auto it = a && a->type == "texture" && a->strings.size() == 1 ? textures_.find(a->strings[0]) : textures_.end();
+    if (a && a->type != "float" && (a->type != "texture" || it == textures_.end() || !it->second.isFloat)) {
+      m.amountPerChannel = true;
+      std::swap(slot.mixSlots[0], slot.mixSlots[1]);
+      m.amountTexture = varyingTexture(ps, "amount", false, "a mix's amount");
+      if (m.amountTexture < 0) {
+        m.amountRgb = color(ps, "amount", Rgb(0.5f));
+        for (int i = 0; i < 3; ++i) m.amountRgb[i] = std::clamp(m.amountRgb[i], 0.0f, 1.0f);  // pbrt-v3's Clamp()
+      }
+    } else {
+      // pbrt-v4's amount is a FloatTexture: per hit (Scene::materialAt); a
+      // value outside [0, 1] there picks one component, as in pbrt.
+      m.amountTexture = varyingTexture(ps, "amount", true, "a mix's amount");
+      if (m.amountTexture < 0) m.amount = float(floatParam(ps, "amount", 0.5));
+      if (!(m.amount >= 0 && m.amount <= 1)) failAt(at, label + ": amount must be in [0, 1]");
     }
-    m.amountTexture = varyingTexture(ps, "amount", true, "a mix's amount");
-    if (m.amountTexture < 0) m.amount = float(floatParam(ps, "amount", 0.5));
-    if (!(m.amount >= 0 && m.amount <= 1)) failAt(at, label + ": amount must be in [0, 1]");
   } else if (type == "measured") {
     failAt(at, label + ": measured BSDFs (tabulated \"filename\" data) are not supported: tdpm has no tabulated "
                        "BSDF; use a conductor or coateddiffuse of similar appearance");

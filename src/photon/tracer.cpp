@@ -520,7 +520,8 @@ struct Tracer {
         if (settings.invariant == InvariantPhotons::Only) return rays;  // nothing further is invariant
       }
       if (hit.isLight()) return rays;  // emitters absorb
-      const Material& mat = scene.materialAt(hit, -dir);
+      Rgb mixWeight(1.0f);  // a per-channel mix's weight (Scene::materialAt)
+      const Material& mat = scene.materialAt(hit, -dir, &mixWeight);
       // A sharp metal continues a caustic path (after storing there: the
       // caustic seen on the metal itself is L S+ G).
       bool glossyBounce = settings.glossyCaustics && mat.isGlossy();
@@ -536,7 +537,7 @@ struct Tracer {
         if (settings.kind == MapKind::Caustic && !glossyBounce) return rays;  // L (S|G)+ D ends here
       }
       std::optional<Material> textured;
-      ShadingContext ctx = scene.shadingContext(mat, hit, -dir, textured);
+      ShadingContext ctx = scene.shadingContext(mat, hit, -dir, textured, mixWeight);
       BsdfSample bs;
       Vec3f ub = rng.get3D(dims::vertexGroup(bounce, dims::kBsdf));
       if (!bsdfSample(ctx, {ub.x, ub.y}, ub.z, Transport::Importance, bs)) return rays;

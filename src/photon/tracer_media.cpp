@@ -79,7 +79,8 @@ uint64_t walkPhotonInMedia(const Scene& scene, const TraceSettings& settings, co
       continue;
     }
     // ---- a surface vertex: as photon/tracer.cpp's tracePath ----
-    const Material& mat = scene.materialAt(hit, -dir);
+    Rgb mixWeight(1.0f);  // a per-channel mix's weight (Scene::materialAt)
+    const Material& mat = scene.materialAt(hit, -dir, &mixWeight);
     bool glossyBounce = settings.glossyCaustics && mat.isGlossy();
     if (!mat.isDeltaOnly()) {
       bool store = !volume && (settings.kind == MapKind::Global || (bounce > 0 && allSpecular)) && keeps();
@@ -90,7 +91,7 @@ uint64_t walkPhotonInMedia(const Scene& scene, const TraceSettings& settings, co
       if (caustic && !glossyBounce) return rays;  // L (S|G)+ D ends here
     }
     std::optional<Material> textured;
-    ShadingContext ctx = scene.shadingContext(mat, hit, -dir, textured);
+    ShadingContext ctx = scene.shadingContext(mat, hit, -dir, textured, mixWeight);
     BsdfSample bs;
     Vec3f ub = rng.get3D(dims::vertexGroup(bounce, dims::kBsdf));
     if (!bsdfSample(ctx, {ub.x, ub.y}, ub.z, Transport::Importance, bs)) return rays;

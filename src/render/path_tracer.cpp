@@ -62,9 +62,10 @@ Rgb PathTracer::trace(Vec3f origin, Vec3f dir, float time01, Stream& sampler, Th
       break;  // emitters do not reflect
     }
     if (depth == lastDepth) break;
-    const Material& mat = scene_.materialAt(hit, -dir);
+    Rgb mixWeight(1.0f);  // a per-channel mix's weight (Scene::materialAt)
+    const Material& mat = scene_.materialAt(hit, -dir, &mixWeight);
     std::optional<Material> textured;
-    ShadingContext ctx = scene_.shadingContext(mat, hit, -dir, textured);
+    ShadingContext ctx = scene_.shadingContext(mat, hit, -dir, textured, mixWeight);
 
     // Guide cones at the first two diffuse vertices: not only a caustic
     // seen directly (or in a mirror), but also one lighting what is seen,

@@ -249,9 +249,10 @@ Rgb PhotonIntegrator::finalGather(const Hit& hit, const ShadingContext& ctx, flo
         }
         break;
       }
-      const Material& m = scene_.materialAt(h, -d);
+      Rgb mixWeight(1.0f);  // a per-channel mix's weight (Scene::materialAt)
+      const Material& m = scene_.materialAt(h, -d, &mixWeight);
       std::optional<Material> textured;
-      ShadingContext c = scene_.shadingContext(m, h, -d, textured);
+      ShadingContext c = scene_.shadingContext(m, h, -d, textured, mixWeight);
       // Through mirrors, glass and sharp metals to the first diffuse-like
       // surface: light a sharp metal reflects toward the gather point is in
       // the caustic map (L (S|G)+ D, Material::isGlossy), and light reaching
@@ -360,9 +361,10 @@ Rgb PhotonIntegrator::traceFrom(Vec3f origin, Vec3f dir, float time01, EyeVertex
       }
       break;
     }
-    const Material& mat = scene_.materialAt(hit, -dir);
+    Rgb mixWeight(1.0f);  // a per-channel mix's weight (Scene::materialAt)
+    const Material& mat = scene_.materialAt(hit, -dir, &mixWeight);
     std::optional<Material> textured;
-    ShadingContext ctx = scene_.shadingContext(mat, hit, -dir, textured);
+    ShadingContext ctx = scene_.shadingContext(mat, hit, -dir, textured, mixWeight);
     bool timeDependent = s_.timeDependent && touched;
     float minVolume = s_.footprintVolume * pathLength * pathLength;
 

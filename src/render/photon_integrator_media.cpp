@@ -143,9 +143,10 @@ Rgb PhotonIntegrator::finalGatherMedia(const Hit& hit, const ShadingContext& ctx
         }
         break;
       }
-      const Material& mat = scene_.materialAt(h, -d);
+      Rgb mixWeight(1.0f);  // a per-channel mix's weight (Scene::materialAt)
+      const Material& mat = scene_.materialAt(h, -d, &mixWeight);
       std::optional<Material> textured;
-      ShadingContext c = scene_.shadingContext(mat, h, -d, textured);
+      ShadingContext c = scene_.shadingContext(mat, h, -d, textured, mixWeight);
       if (!mat.isCausticBounce()) {
         sum += beta * estimate(global_, ts.global, ts.global3, h, c, -d, time01, s_.timeDependent && moved, ts);
         break;
@@ -216,9 +217,10 @@ Rgb PhotonIntegrator::traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& 
       break;
     }
     const SceneObject& obj = scene_.objects[hit.object];
-    const Material& mat = scene_.materialAt(hit, -dir);
+    Rgb mixWeight(1.0f);  // a per-channel mix's weight (Scene::materialAt)
+    const Material& mat = scene_.materialAt(hit, -dir, &mixWeight);
     std::optional<Material> textured;
-    ShadingContext ctx = scene_.shadingContext(mat, hit, -dir, textured);
+    ShadingContext ctx = scene_.shadingContext(mat, hit, -dir, textured, mixWeight);
     bool timeDependent = s_.timeDependent && touched;
     float minVolume = s_.footprintVolume * pathLength * pathLength;
 

@@ -193,9 +193,10 @@ Rgb PathTracer::traceMedia(Vec3f origin, Vec3f dir, float time01, Stream& sample
     }
     // ---- a surface vertex ----
     if (depth == lastDepth) break;
-    const Material& mat = scene_.materialAt(hit, -dir);
+    Rgb mixWeight(1.0f);  // a per-channel mix's weight (Scene::materialAt)
+    const Material& mat = scene_.materialAt(hit, -dir, &mixWeight);
     std::optional<Material> textured;
-    ShadingContext ctx = scene_.shadingContext(mat, hit, -dir, textured);
+    ShadingContext ctx = scene_.shadingContext(mat, hit, -dir, textured, mixWeight);
     if (directOnly_ && !mat.isDeltaOnly()) lastDepth = std::min(lastDepth, depth + 1);
     cones.clear();
     if (guide_ && !mat.isDeltaOnly() && diffuseVertices < kGuidedDiffuseVertices)

@@ -86,7 +86,8 @@ ShadingContext makeShadingContext(const Material& m, Rgb albedo, Vec3f outwardNo
   return c;
 }
 
-Rgb bsdfEval(const ShadingContext& c, Vec3f wiWorld) {
+namespace {
+Rgb evalComponent(const ShadingContext& c, Vec3f wiWorld) {
   Vec3f wo = c.woLocal, wi = c.frame.toLocal(wiWorld);
   const Material& m = *c.material;
   if (c.shaded && !c.sidesAgree(wiWorld)) return Rgb(0.0f);
@@ -108,6 +109,19 @@ Rgb bsdfEval(const ShadingContext& c, Vec3f wiWorld) {
     default:  // mirror, dielectric: delta only
       return Rgb(0.0f);
   }
+}
+bool sampleComponent(const ShadingContext& c, Vec2f u, float uLobe, Transport mode, BsdfSample& out);
+}  // namespace
+
+Rgb bsdfEval(const ShadingContext& c, Vec3f wiWorld) {
+  Rgb f = evalComponent(c, wiWorld);
+  return c.mixWeighted ? f * c.mixWeight : f;
+}
+
+bool bsdfSample(const ShadingContext& c, Vec2f u, float uLobe, Transport mode, BsdfSample& out) {
+  if (!sampleComponent(c, u, uLobe, mode, out)) return false;
+  if (c.mixWeighted) out.weight = out.weight * c.mixWeight;
+  return true;
 }
 
 float bsdfPdf(const ShadingContext& c, Vec3f wiWorld) {
@@ -139,12 +153,14 @@ float dielectricBranches(const ShadingContext& c, Transport mode, BsdfSample& re
   return F;
 }
 
-bool bsdfSample(const ShadingContext& c, Vec2f u, float uLobe, Transport mode, BsdfSample& out) {
+namespace {
+// bsdfSample without the per-channel mix's weight (bsdfSample applies it once).
+bool sampleComponent(const ShadingContext& c, Vec2f u, float uLobe, Transport mode, BsdfSample& out) {
   if (c.shaded) {
     // As below, then the shading and geometric normals must agree (bsdf.h).
     ShadingContext plain = c;
     plain.shaded = false;
-    return bsdfSample(plain, u, uLobe, mode, out) && c.sidesAgree(out.wi);
+    return sampleComponent(plain, u, uLobe, mode, out) && c.sidesAgree(out.wi);
   }
   const Material& m = *c.material;
   Vec3f wo = c.woLocal;
@@ -190,11 +206,12 @@ bool bsdfSample(const ShadingContext& c, Vec2f u, float uLobe, Transport mode, B
       Vec3f wiWorld = c.frame.toWorld(wi);
       float pdf = bsdfPdf(c, wiWorld);
       if (!(pdf > 0)) return false;
-      out = {wiWorld, bsdfEval(c, wiWorld) * (wi.z / pdf), pdf, false};
+      out = {wiWorld, evalComponent(c, wiWorld) * (wi.z / pdf), pdf, false};
       return true;
     }
     default: return pbrtBsdfSample(c, u, uLobe, mode, out);
   }
 }
+}  // namespace
 
 }  // namespace tdpm

@@ -33,6 +33,11 @@ struct ShadingContext {
     return ((dot(woWorld(), ng) > 0) == (dot(wiWorld, ng) > 0)) == ((woLocal.z > 0) == (dot(wiWorld, frame.n) > 0));
   }
   Vec3f woWorld() const { return frame.toWorld(woLocal); }
+  // A per-channel mix's weight for the component chosen at this hit
+  // (Material::mixPerChannel, Scene::materialAt): bsdfEval and bsdfSample
+  // scale their values by it when mixWeighted; pdfs are the component's.
+  bool mixWeighted = false;
+  Rgb mixWeight{1.0f};
 };
 
 // Builds the context at a hit: flips the frame toward wo unless the

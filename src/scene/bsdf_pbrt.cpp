@@ -1,6 +1,7 @@
 // scene/bsdf_pbrt.cpp — pbrt's materials as tdpm BSDFs: the complex-IOR
 // conductor and the rough dielectric as pbrt-v4 has them, pbrt-v3's uber
-// (non-specular lobes) and substrate (Ashikhmin-Shirley FresnelBlend), and
+// (non-specular lobes), substrate (Ashikhmin-Shirley FresnelBlend) and
+// matte with sigma > 0 (Oren-Nayar), and
 // closed-form stand-ins for pbrt-v4's stochastic layered coateddiffuse and
 // coatedconductor (docs/scene-format.md says how they are built and
 // tests/test_materials.cpp measures them against a random walk through the
@@ -205,6 +206,23 @@ Rgb coatedConductorBase(const Material& m, Vec3f wo, Vec3f wi, float* pdf) {
          (microfacetReflection(woIn, wiIn, wm, m.baseAlpha) * coatThrough(m, wo, wi, woIn, wiIn));
 }
 
+// pbrt-v3's OrenNayar::f / (R / pi): A + B max(0, cos(phi_i - phi_o))
+// sin(alpha) tan(beta), alpha the larger polar angle, beta the smaller.
+float orenNayarFactor(const Material& m, Vec3f wo, Vec3f wi) {
+  float sinI = std::sqrt(std::max(0.0f, 1.0f - wi.z * wi.z)), sinO = std::sqrt(std::max(0.0f, 1.0f - wo.z * wo.z));
+  float maxCos = 0.0f;
+  if (sinI > 1e-4f && sinO > 1e-4f) maxCos = std::clamp((wi.x * wo.x + wi.y * wo.y) / (sinI * sinO), 0.0f, 1.0f);
+  float sinAlpha, tanBeta;
+  if (wi.z > wo.z) {
+    sinAlpha = sinO;
+    tanBeta = sinI / wi.z;
+  } else {
+    sinAlpha = sinI;
+    tanBeta = sinO / wo.z;
+  }
+  return m.orenA + m.orenB * maxCos * sinAlpha * tanBeta;
+}
+
 float uberSpecularProbability(const ShadingContext& c) {
   bool d = !c.albedo.isBlack(), s = !c.material->specular.isBlack();
   return s ? (d ? 0.5f : 1.0f) : 0.0f;
@@ -267,6 +285,7 @@ Rgb pbrtBsdfEval(const ShadingContext& c, Vec3f wo, Vec3f wi) {
     case T::CoatedDiffuse: return coatedDiffuseEval(c, wo, wi);
     case T::CoatedConductor:
       return coatedConductorBase(m, wo, wi, nullptr) + Rgb(coatSpecular(m, wo, wi, wm));
+    case T::OrenNayar: return c.albedo * (kInvPi * orenNayarFactor(m, wo, wi));
     default: return Rgb(0.0f);
   }
 }
@@ -292,6 +311,7 @@ float pbrtBsdfPdf(const ShadingContext& c, Vec3f wo, Vec3f wi) {
       return kCoatSpecularProbability * microfacetReflectionPdf(wo, wm, m.alpha) +
              (1.0f - kCoatSpecularProbability) * base;
     }
+    case T::OrenNayar: return cosineHemispherePdf(wi.z);  // pbrt-v3's BxDF::Sample_f: cosine-weighted
     default: return 0.0f;
   }
 }
@@ -330,6 +350,7 @@ bool pbrtBsdfSample(const ShadingContext& c, Vec2f u, float uLobe, Transport mod
         wi = {sx, sy, std::sqrt(1.0f - s2)};
       }
       break;
+    case T::OrenNayar: wi = squareToCosineHemisphere(u); break;
     default: return false;
   }
   if (wi.z <= 0) return false;

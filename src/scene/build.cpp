@@ -148,6 +148,15 @@ Material toMaterial(const scene::MaterialDesc& d) {
   m.mixOf[0] = d.mix[0];
   m.mixOf[1] = d.mix[1];
   m.mixAmount = d.amount;
+  m.mixPerChannel = d.amountPerChannel;
+  m.mixAmountRgb = d.amountRgb;
+  m.thicknessTexture = d.thicknessTexture;
+  // pbrt-v3's matte with a sigma: Oren-Nayar; sigma 0 stays Lambert (bsdf.cpp's own path).
+  if (m.type == T::Diffuse && (d.sigma > 0.0f || d.sigmaTexture >= 0)) {
+    m.type = T::OrenNayar;
+    orenNayarAB(d.sigma, &m.orenA, &m.orenB);
+    m.sigmaTexture = d.sigmaTexture;
+  }
   return m;
 }
 
@@ -202,6 +211,22 @@ void checkTexturedIor(const scene::MaterialDesc& d, const TextureSet& textures) 
   if (!(lo >= 1))
     throw Error("material \"" + d.name + "\": its ior texture's values [" + std::to_string(lo) + ", " + std::to_string(hi) +
                 "] reach below 1, which tdpm does not support (an ior must be at least 1)");
+}
+
+// A material's texture index (sigma, thickness, a per-channel amount): none or a node of the set.
+void checkTextureIndex(const scene::MaterialDesc& d, int32_t node, const char* what, const TextureSet& textures) {
+  if (node >= int32_t(textures.nodes.size()))
+    throw Error("material \"" + d.name + "\": " + what + " texture index out of range");
+}
+
+// A textured coating thickness: every value at least 0 (as the constant;
+// a negative optical depth would make the layer amplify).
+void checkTexturedThickness(const scene::MaterialDesc& d, const TextureSet& textures) {
+  float lo, hi;
+  textures.range(uint32_t(d.thicknessTexture), &lo, &hi);
+  if (!(lo >= 0))
+    throw Error("material \"" + d.name + "\": its thickness texture's values [" + std::to_string(lo) + ", " +
+                std::to_string(hi) + "] reach below 0; a coating's thickness must not be negative");
 }
 
 // A mix's components' classification (Material::causticTarget), through
@@ -441,6 +466,10 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
     s.materials.push_back(toMaterial(m));
     if (m.roughnessTexture >= 0 || m.baseRoughnessTexture >= 0) classifyTexturedRoughness(s.materials.back(), m, s.textures);
     if (m.iorTexture >= 0) checkTexturedIor(m, s.textures);
+    checkTextureIndex(m, m.sigmaTexture, "sigma", s.textures);
+    checkTextureIndex(m, m.thicknessTexture, "thickness", s.textures);
+    if (m.amountPerChannel) checkTextureIndex(m, m.amountTexture, "amount", s.textures);
+    if (m.thicknessTexture >= 0) checkTexturedThickness(m, s.textures);
   }
   // Normal maps: their texels join the texture images (one copy per file).
   bool shadingNormals = false;

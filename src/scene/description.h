@@ -141,8 +141,18 @@ struct MaterialDesc {
   Rgb eta{1, 1, 1}, k{0, 0, 0};  // conductor, coated conductor's base: complex IOR (absolute)
   float baseRoughness = 0.0f;  // coated conductor: the conductor's GGX alpha in [0, 1]
   float thickness = 0.01f;     // coated: the layer's thickness (pbrt-v4's units: optical depth)
+  int32_t thicknessTexture = -1;  // coated: a float texture for thickness when >= 0 (values >= 0)
+  // Diffuse: Oren-Nayar roughness sigma in degrees, [0, 90] (pbrt-v3's
+  // matte; 0 is Lambert), or a float texture for it when sigmaTexture >= 0.
+  float sigma = 0.0f;
+  int32_t sigmaTexture = -1;
   uint32_t mix[2] = {0, 0};    // mix: indices into SceneDescription::materials
   float amount = 0.5f;         // mix: probability of mix[1], in [0, 1]
+  // Mix, per channel (pbrt-v3's Spectrum amount; JSON "amount": [r, g, b] or
+  // a spectrum texture): f = (1 - a) f(mix[0]) + a f(mix[1]) in each channel,
+  // a = amountRgb or, when amountTexture >= 0, that spectrum texture.
+  bool amountPerChannel = false;
+  Rgb amountRgb{0.5f, 0.5f, 0.5f};
   // Diffuse / plastic: a named texture (index into SceneDescription::
   // textures, a spectrum one) that replaces albedo when >= 0.
   int32_t albedoTexture = -1;

@@ -178,8 +178,14 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
     j["eta"] = m.etaTexture >= 0 ? Json(textures.at(size_t(m.etaTexture))) : rgb(m.eta);
     j["k"] = m.kTexture >= 0 ? Json(textures.at(size_t(m.kTexture))) : rgb(m.k);
   };
+  Json thickness = m.thicknessTexture >= 0 ? Json(textures.at(size_t(m.thicknessTexture))) : Json(num(m.thickness));
   switch (m.type) {
-    case T::Diffuse: j["type"] = "diffuse"; albedo(); break;
+    case T::Diffuse:
+      j["type"] = "diffuse";
+      albedo();
+      if (m.sigmaTexture >= 0) j["sigma"] = textures.at(size_t(m.sigmaTexture));
+      else if (m.sigma != 0.0f) j["sigma"] = num(m.sigma);
+      break;
     case T::Interface: j["type"] = "interface"; break;
     case T::Mirror: j["type"] = "mirror"; j["color"] = spec; break;
     case T::Dielectric: j["type"] = "dielectric"; j["ior"] = iorValue; j["tint"] = spec; break;
@@ -214,7 +220,7 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
       albedo();
       j["ior"] = num(m.ior);
       j["roughness"] = rough();
-      j["thickness"] = num(m.thickness);
+      j["thickness"] = thickness;
       break;
     case T::CoatedConductor:
       j["type"] = "coatedconductor";
@@ -223,12 +229,13 @@ Json material(const scene::MaterialDesc& m, const std::vector<scene::MaterialDes
       complexIor();
       j["conductor_roughness"] =
           m.baseRoughnessTexture < 0 ? Json(num(m.baseRoughness)) : Json(textures.at(size_t(m.baseRoughnessTexture)));
-      j["thickness"] = num(m.thickness);
+      j["thickness"] = thickness;
       break;
     case T::Mix:
       j["type"] = "mix";
       j["materials"] = Json::array({materials.at(m.mix[0]).name, materials.at(m.mix[1]).name});
-      j["amount"] = m.amountTexture >= 0 ? Json(textures.at(size_t(m.amountTexture))) : Json(num(m.amount));
+      if (m.amountTexture >= 0) j["amount"] = textures.at(size_t(m.amountTexture));  // a spectrum one: per channel
+      else j["amount"] = m.amountPerChannel ? rgb(m.amountRgb) : Json(num(m.amount));
       break;
   }
   // Shading normals (parse.cpp readShadingNormal).

@@ -52,7 +52,11 @@ struct Material {
   enum class Type : uint8_t {
     Diffuse, Mirror, Dielectric, Metal, Plastic,
     Conductor, RoughDielectric, Uber, Substrate, CoatedDiffuse, CoatedConductor, Mix,
-    Interface  // no surface: a boundary between media only (no parser makes one yet)
+    Interface,  // no surface: a boundary between media only (no parser makes one yet)
+    // pbrt-v3's matte with sigma > 0 (or a sigma texture): the Oren-Nayar
+    // lobe (pbrt-v3's OrenNayar, cosine-sampled). Last, so that Diffuse
+    // (sigma 0) keeps its own path in bsdf.cpp and renders as before.
+    OrenNayar
   };
   Type type = Type::Diffuse;
   Texture albedo;            // diffuse reflectance / plastic, uber, substrate, coated-diffuse base colour
@@ -63,6 +67,7 @@ struct Material {
   float baseAlpha = 0.0f;    // coated conductor: the conductor's GGX alpha
   float thickness = 0.01f;   // coated: the layer's optical depth along the normal (pbrt-v4's Tr)
   float coatInternal = 0.0f; // coated: the layer's cosine-averaged internal reflectance (set at build)
+  float orenA = 1.0f, orenB = 0.0f;  // Oren-Nayar: pbrt-v3's A and B (orenNayarAB) for the constant sigma
   uint32_t mixOf[2] = {0, 0};  // mix: the two materials' indices
   float mixAmount = 0.5f;      // mix: probability of mixOf[1]
   bool mixDelta = false, mixCaustic = false;  // mix: a component is delta-only / a caustic bounce (set at build)
@@ -88,7 +93,21 @@ struct Material {
   int32_t etaTexture = -1, kTexture = -1;
   // >= 0: a mix's amount is this float node at the hit (pbrt-v4's
   // FloatTexture), read by resolveMaterial through Scene::materialAt.
+  // With mixPerChannel a spectrum node (or, < 0, mixAmountRgb).
   int32_t amountTexture = -1;
+  // A per-channel mix (pbrt-v3's Spectrum amount): f = (1 - a) f_0 + a f_1
+  // per channel. Scene::materialAt picks mixOf[1] with probability p = the
+  // channels' mean of a and weights the choice a / p (or (1 - a) / (1 - p)),
+  // which the ShadingContext's mixWeight carries into every BSDF value: the
+  // estimator's expectation is the per-channel blend.
+  bool mixPerChannel = false;
+  Rgb mixAmountRgb{0.5f};
+  // >= 0: Oren-Nayar's sigma (degrees, clamped to [0, 90] as pbrt-v3) is
+  // this float node at the hit; orenA / orenB then come from it per hit.
+  int32_t sigmaTexture = -1;
+  // >= 0: a coating's thickness is this float node at the hit (pbrt-v4's
+  // FloatTexture; build.cpp refuses a texture whose range reaches below 0).
+  int32_t thicknessTexture = -1;
   // >= 0: a dielectric's (rough dielectric's, uber's) ior is this float
   // node at the hit (pbrt-v3's glass and uber eta FloatTextures), kept >= 1;
   // build.cpp refuses a texture whose range reaches below 1.
@@ -132,6 +151,16 @@ struct Material {
   bool causticTarget(bool glossy) const { return glossy ? isCausticBounce() || mixCaustic : isDeltaOnly() || mixDelta; }
 };
 
+// pbrt-v3's OrenNayar constructor: sigma in degrees (clamped to [0, 90], as
+// pbrt-v3's MatteMaterial clamps its texture), A and B of the qualitative
+// model (Oren and Nayar 1994). sigma 0: A = 1, B = 0, Lambert's values.
+inline void orenNayarAB(float sigmaDegrees, float* A, float* B) {
+  float s = std::clamp(sigmaDegrees, 0.0f, 90.0f) * (kPi / 180.0f);
+  float s2 = s * s;
+  *A = 1.0f - s2 / (2.0f * (s2 + 0.33f));
+  *B = 0.45f * s2 / (s2 + 0.09f);
+}
+
 // The material a hit uses: a mix material picks one of its two per hit,
 // deterministically from the point and direction (as pbrt-v4's MixMaterial
 // hashes them), with probability amount(mix) for the second; mixes of mixes
@@ -140,8 +169,11 @@ struct Material {
 // scene and its `tdpm convert` JSON number materials differently.
 // amount(const Material&) -> float: the mix's amount at this hit (its
 // constant, or its texture there: Scene::materialAt); asked only of mixes.
-template <class Amount>
-inline const Material& resolveMaterial(const Material* materials, uint32_t index, Vec3f p, Vec3f wo, Amount amount) {
+// chosen(const Material& mix, bool second, float amount): told each choice
+// (a per-channel mix's weight, Scene::materialAt).
+template <class Amount, class Chosen>
+inline const Material& resolveMaterial(const Material* materials, uint32_t index, Vec3f p, Vec3f wo, Amount amount,
+                                       Chosen chosen) {
   const Material* m = materials + index;
   if (m->type != Material::Type::Mix) return *m;
   float v[6] = {p.x, p.y, p.z, wo.x, wo.y, wo.z};
@@ -161,9 +193,15 @@ inline const Material& resolveMaterial(const Material* materials, uint32_t index
     float u = float(z >> 40) * 0x1p-24f;  // [0, 1)
     // pbrt-v4: amount <= 0 is the first, >= 1 the second, else amount < u the first.
     float a = amount(*m);
-    m = materials + (a < u || a <= 0.0f ? m->mixOf[0] : m->mixOf[1]);
+    bool second = !(a < u || a <= 0.0f);
+    chosen(*m, second, a);
+    m = materials + (second ? m->mixOf[1] : m->mixOf[0]);
   }
   return *m;
+}
+template <class Amount>
+inline const Material& resolveMaterial(const Material* materials, uint32_t index, Vec3f p, Vec3f wo, Amount amount) {
+  return resolveMaterial(materials, index, p, wo, amount, [](const Material&, bool, float) {});
 }
 // Constant amounts only (tests, and materials without an amount texture).
 inline const Material& resolveMaterial(const Material* materials, uint32_t index, Vec3f p, Vec3f wo) {

@@ -658,7 +658,7 @@ struct MaterialKind {
 const std::vector<MaterialKind>& materialKinds() {
   using T = MaterialDesc::Type;
   static const std::vector<MaterialKind> kinds = {
-      {"diffuse", T::Diffuse, {"type", "color", "texture"}},
+      {"diffuse", T::Diffuse, {"type", "color", "texture", "sigma"}},
       {"mirror", T::Mirror, {"type", "color"}},
       {"dielectric", T::Dielectric, {"type", "ior", "tint", "roughness", "roughness_remap"}},
       {"metal", T::Metal, {"type", "color", "roughness", "roughness_remap"}},
@@ -738,7 +738,18 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader*
       mixNames->push_back(e.string());
     }
     if (n.has("amount") && n.member("amount").json().is_string()) {
-      m.amountTexture = namedTextureIndex(n.member("amount"), textures, true);  // per hit (Scene::materialAt)
+      // Per hit (Scene::materialAt): a float texture picks a material, a
+      // spectrum one blends the two per channel (pbrt-v3's Spectrum amount).
+      Node a = n.member("amount");
+      if (!textures) a.fail("unknown texture \"" + a.string() + "\"; no textures are defined");
+      m.amountTexture = textures->index(a.string(), a);
+      m.amountPerChannel = !(*textures->out())[size_t(m.amountTexture)].isFloat;
+    } else if (n.has("amount") && n.member("amount").json().is_array()) {
+      Node a = n.member("amount");
+      m.amountPerChannel = true;
+      m.amountRgb = a.color();
+      for (int i = 0; i < 3; ++i)
+        a.require(m.amountRgb[i] >= 0 && m.amountRgb[i] <= 1, "amount must be in [0, 1] in every channel, got " + formatRgb(m.amountRgb));
     } else if (n.has("amount")) {
       m.amount = n.member("amount").number();
       n.member("amount").require(m.amount >= 0 && m.amount <= 1, "amount must be in [0, 1], got " + fmt(m.amount));
@@ -794,9 +805,17 @@ MaterialDesc readMaterial(const Node& n, const std::string& name, TextureReader*
               "roughness_remap applies only to a textured roughness (a constant one is the GGX alpha)");
     m.roughnessRemap = v == "pbrt-v3" ? MaterialDesc::Remap::PbrtV3 : v == "pbrt-v4" ? MaterialDesc::Remap::PbrtV4 : MaterialDesc::Remap::None;
   }
-  if (n.has("thickness")) {
+  if (n.has("thickness") && n.member("thickness").json().is_string()) {
+    m.thicknessTexture = namedTextureIndex(n.member("thickness"), textures, true);  // per hit; build.cpp checks its range
+  } else if (n.has("thickness")) {
     m.thickness = n.member("thickness").number();
     n.member("thickness").require(m.thickness >= 0 && std::isfinite(m.thickness), "thickness must be non-negative, got " + fmt(m.thickness));
+  }
+  if (n.has("sigma") && n.member("sigma").json().is_string()) {
+    m.sigmaTexture = namedTextureIndex(n.member("sigma"), textures, true);  // per hit, clamped to [0, 90]
+  } else if (n.has("sigma")) {
+    m.sigma = n.member("sigma").number();
+    n.member("sigma").require(m.sigma >= 0 && m.sigma <= 90, "sigma (Oren-Nayar, degrees) must be in [0, 90], got " + fmt(m.sigma));
   }
   readShadingNormal(n, &m, textures, sceneDir);
   return m;

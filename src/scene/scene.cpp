@@ -164,6 +164,8 @@ const Material& Scene::shadeTextured(const Material& m, const Hit& hit, std::opt
     float x = textures.eval(uint32_t(m.baseRoughnessTexture), tp).r;
     scratch->baseAlpha = std::clamp(roughnessToAlpha(x, m.roughnessRemap), 1e-3f, 1.0f);
   }
+  if (m.sigmaTexture >= 0) orenNayarAB(textures.eval(uint32_t(m.sigmaTexture), tp).r, &scratch->orenA, &scratch->orenB);
+  if (m.thicknessTexture >= 0) scratch->thickness = std::max(textures.eval(uint32_t(m.thicknessTexture), tp).r, 0.0f);
   return *scratch;
 }
 

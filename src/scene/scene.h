@@ -90,11 +90,12 @@ class Scene {
   // parameters) a copy in `scratch` with the values at the hit: the
   // specular colour clamped to [0, 1] (a conductor's reflectance becomes
   // its eta, k), a textured eta / k (clamped to eta >= 1e-3, k >= 0), a textured ior (>= 1), the roughness remapped and clamped to [1e-3, 1] (never a
-  // delta lobe on a material classified non-delta). An empty optional costs
+  // delta lobe on a material classified non-delta), Oren-Nayar's A, B from a
+  // textured sigma, a textured coating thickness (>= 0). An empty optional costs
   // an untextured hit nothing.
   const Material& shadedMaterial(const Material& m, const Hit& hit, std::optional<Material>& scratch) const {
     if (m.specularTexture < 0 && m.roughnessTexture < 0 && m.baseRoughnessTexture < 0 && m.etaTexture < 0 &&
-        m.kTexture < 0 && m.iorTexture < 0)
+        m.kTexture < 0 && m.iorTexture < 0 && m.sigmaTexture < 0 && m.thicknessTexture < 0)
       return m;
     return shadeTextured(m, hit, scratch);
   }
@@ -103,9 +104,18 @@ class Scene {
   // about the geometric normal, or the bumped / normal-mapped shading normal
   // when the material has one (scene/shading_normal.cpp). Every integrator
   // builds its contexts here, so shading normals apply everywhere.
-  ShadingContext shadingContext(const Material& m, const Hit& hit, Vec3f wo, std::optional<Material>& scratch) const {
-    if (!m.hasShadingNormal()) return makeShadingContext(shadedMaterial(m, hit, scratch), albedoAt(m, hit), hit.n, wo);
-    return makeShadingContext(shadedMaterial(m, hit, scratch), albedoAt(m, hit), hit.n, wo, shadingNormal(m, hit));
+  // mixWeight: what materialAt gave for a per-channel mix (1 otherwise).
+  ShadingContext shadingContext(const Material& m, const Hit& hit, Vec3f wo, std::optional<Material>& scratch,
+                                Rgb mixWeight = Rgb(1.0f)) const {
+    ShadingContext c =
+        m.hasShadingNormal()
+            ? makeShadingContext(shadedMaterial(m, hit, scratch), albedoAt(m, hit), hit.n, wo, shadingNormal(m, hit))
+            : makeShadingContext(shadedMaterial(m, hit, scratch), albedoAt(m, hit), hit.n, wo);
+    if (mixWeight.r != 1.0f || mixWeight.g != 1.0f || mixWeight.b != 1.0f) {
+      c.mixWeighted = true;
+      c.mixWeight = mixWeight;
+    }
+    return c;
   }
   // The material's shading normal at the hit (unit, on hit.n's side):
   // pbrt-v4's BumpMap (the displaced surface's dp/du x dp/dv) or NormalMap
@@ -118,10 +128,29 @@ class Scene {
   // The material a hit on an object uses, seen from direction wo:
   // resolveMaterial (material.h) with each mix's amount at the hit, its
   // texture evaluated there when it has one (pbrt-v4's FloatTexture amount).
-  const Material& materialAt(const Hit& hit, Vec3f wo) const {
-    return resolveMaterial(materials.data(), objects[hit.object].material, hit.p, wo, [&](const Material& m) {
-      return m.amountTexture < 0 ? m.mixAmount : textures.eval(uint32_t(m.amountTexture), {uvAt(hit), hit.localP}).r;
-    });
+  // A per-channel mix (Material::mixPerChannel) multiplies *mixWeight by
+  // its choice's weight, which the caller passes on to shadingContext:
+  // every integrator does, so the per-channel blend holds in each. Without
+  // mixWeight (tests, classification) the choice alone.
+  const Material& materialAt(const Hit& hit, Vec3f wo, Rgb* mixWeight = nullptr) const {
+    Rgb channels;  // the per-channel amount of the mix being resolved
+    return resolveMaterial(
+        materials.data(), objects[hit.object].material, hit.p, wo,
+        [&](const Material& m) {
+          if (!m.mixPerChannel)
+            return m.amountTexture < 0 ? m.mixAmount : textures.eval(uint32_t(m.amountTexture), {uvAt(hit), hit.localP}).r;
+          channels = channelAmount(m, hit);
+          return (channels.r + channels.g + channels.b) * (1.0f / 3.0f);
+        },
+        [&](const Material& m, bool second, float p) {
+          if (!m.mixPerChannel || !mixWeight) return;
+          *mixWeight = *mixWeight * (second ? channels / p : (Rgb(1.0f) - channels) / (1.0f - p));
+        });
+  }
+  // A per-channel mix's amount at the hit, each channel clamped to [0, 1] (pbrt-v3's Clamp()).
+  Rgb channelAmount(const Material& m, const Hit& hit) const {
+    Rgb a = m.amountTexture < 0 ? m.mixAmountRgb : textures.eval(uint32_t(m.amountTexture), {uvAt(hit), hit.localP});
+    return {std::clamp(a.r, 0.0f, 1.0f), std::clamp(a.g, 0.0f, 1.0f), std::clamp(a.b, 0.0f, 1.0f)};
   }
   // The raw ray tracer (benchmarks compare our tracing against it).
   const EmbreeScene& embree() const { return embree_; }
