@@ -89,7 +89,11 @@ Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::G
                                float minVolume) const {
   if (!map || map->size() == 0) return Rgb(0.0f);
   EstimateCounts& counts = ts.counts;
-  auto brdf = [&ctx](Vec3f wi, Vec3f) { return bsdfEval(ctx, wi); };
+  // At a shading normal each photon's f also takes |wi.ns| / |wi.ng| (bsdf.h).
+  auto brdf = [&ctx](Vec3f wi, Vec3f) {
+    Rgb f = bsdfEval(ctx, wi);
+    return ctx.shaded ? f * gatherShadingFactor(ctx, wi) : f;
+  };
   Vec3f n = ctx.frame.n;  // faces the viewer: photons from the other side do not count
   // Nor do photons on the other side of this object's surface, which the
   // side test alone lets through convex edges and thin parts of closed
