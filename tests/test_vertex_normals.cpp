@@ -386,3 +386,26 @@ TEST_CASE("bad vertex normals: located errors, convert writes nothing") {
   CHECK(noted);
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("photons at a shading normal: Veach's adjoint factor and the gather's |wi.ns| / |wi.ng|") {
+  // ng = +z, ns tilted 30 degrees toward +x; a diffuse context seen from wo.
+  Material m;
+  m.type = Material::Type::Diffuse;
+  const float th = 30.0f * kPi / 180.0f;
+  Vec3f ng{0, 0, 1}, ns{std::sin(th), 0, std::cos(th)};
+  Vec3f wPrev = normalize(Vec3f(-0.5f, 0.2f, 1)), wNext = normalize(Vec3f(0.7f, -0.1f, 0.4f));
+  ShadingContext c = makeShadingContext(m, Rgb(0.5f), ng, wPrev, ns);
+  REQUIRE(c.shaded);
+  float want = std::fabs(dot(wPrev, ns)) * std::fabs(dot(wNext, ng)) / (std::fabs(dot(wPrev, ng)) * std::fabs(dot(wNext, ns)));
+  CHECK(adjointShadingFactor(c, wPrev, wNext) == doctest::Approx(want).epsilon(1e-6));
+  CHECK(want != doctest::Approx(1.0f).epsilon(1e-2));  // the factor is not trivially 1 here
+  CHECK(gatherShadingFactor(c, wNext) == doctest::Approx(std::fabs(dot(wNext, ns)) / dot(wNext, ng)).epsilon(1e-6));
+  // Seen from below (frame flipped with the geometric normal): the same values.
+  ShadingContext below = makeShadingContext(m, Rgb(0.5f), ng, -wPrev, ns);
+  REQUIRE(below.shaded);
+  CHECK(adjointShadingFactor(below, -wPrev, -wNext) == doctest::Approx(want).epsilon(1e-6));
+  // Without a shading normal both are exactly 1.
+  ShadingContext plain = makeShadingContext(m, Rgb(0.5f), ng, wPrev);
+  CHECK(adjointShadingFactor(plain, wPrev, wNext) == 1.0f);
+  CHECK(gatherShadingFactor(plain, wNext) == 1.0f);
+}

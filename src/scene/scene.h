@@ -104,8 +104,9 @@ class Scene {
   }
   // The shading context at a hit on an object for the material materialAt
   // gave (textured parameters in `scratch`, as shadedMaterial): its frame
-  // about the geometric normal, or the bumped / normal-mapped shading normal
-  // when the material has one (scene/shading_normal.cpp). Every integrator
+  // about the geometric normal, or about the shading normal when the mesh
+  // has vertex normals or the material a bump / normal map
+  // (scene/shading_normal.cpp). Every integrator
   // builds its contexts here, so shading normals apply everywhere.
   ShadingContext shadingContext(const Material& m, const Hit& hit, Vec3f wo, std::optional<Material>& scratch) const {
     if (!m.hasShadingNormal() && objects[hit.object].normals.empty())
