@@ -92,7 +92,7 @@ Vec3f Scene::interpolatedNormal(const Hit& hit) const {
 
 Vec3f Scene::shadingNormal(const Material& mat, const Hit& hit) const {
   const bool smooth = !objects[hit.object].normals.empty();
-  if (!mat.hasShadingNormal()) return interpolatedNormal(hit);  // only vertex normals
+  if (!mat.hasShadingNormal()) return smooth ? interpolatedNormal(hit) : hit.n;  // vertex normals or none
   Vec3f dpdu, dpdv;
   surfaceTangents(hit, &dpdu, &dpdv);
   const Vec3f ng = hit.n;  // pbrt's n: the shape's orientation, ReverseOrientation applied
