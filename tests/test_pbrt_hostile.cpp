@@ -415,7 +415,7 @@ TEST_CASE("pbrt: the spot falloff note is for pbrt-v4 files only (the quartic is
   CHECK(hasNote(pbrt::importPbrtText("Film \"rgb\"\n" + world, "dir/q.pbrt"), "smoothstep"));
 }
 
-TEST_CASE("pbrt: one note for a PLY's normal (nx, ny, nz), not three") {
+TEST_CASE("pbrt: a PLY's normal (nx, ny, nz) is one shading normal: used, no note") {
   std::string dir = test::makeTempDir();
   test::writeFile(dir + "/n.ply",
                   "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
@@ -423,8 +423,8 @@ TEST_CASE("pbrt: one note for a PLY's normal (nx, ny, nz), not three") {
                   "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n");
   test::writeFile(dir + "/s.pbrt", "WorldBegin\nShape \"plymesh\" \"string filename\" \"n.ply\"\n");
   pbrt::ImportResult r = pbrt::importPbrtFile(dir + "/s.pbrt");
-  CHECK(countNotes(r, "plymesh") == 1);
-  CHECK(hasNote(r, "Shape \"plymesh\": vertex properties \"nx\", \"ny\", \"nz\" ignored"));
+  CHECK(countNotes(r, "plymesh") == 0);
+  CHECK(r.scene.objects.at(0).shape.normals.size() == 3);
 }
 
 TEST_CASE("pbrt: texture errors name every supported kind and type") {

@@ -102,6 +102,9 @@ class Cursor;
 
 // Turns a trianglemesh's windings to face its shading normals N, as pbrt
 // orients such a triangle (pbrt_mapping.cpp); false when it has no N.
+// Swaps the windings of the triangles whose normal disagrees with the sum
+// of their corners' shading normals N (per vertex), as pbrt faces them.
+void orientToNormals(const std::vector<Vec3f>& N, const std::vector<Vec3f>& verts, std::vector<uint32_t>* indices);
 bool facesShadingNormals(const ShapeRecord& rec, const std::vector<Vec3f>& verts, std::vector<uint32_t>* indices);
 
 class Importer {

@@ -703,6 +703,7 @@ struct Geometry {
   std::vector<Vec3f> vertices;
   std::vector<uint32_t> indices;
   std::vector<Vec2f> uv;  // per vertex, when the file gives them (or a single bilinear patch's defaults)
+  std::vector<Vec3f> normals;  // shading normals N / nx ny nz per vertex (object space), or empty
   int loopLevels = -1;    // loopsubdiv: the control mesh above, refined by scene/build.cpp
 };
 }  // namespace
@@ -892,10 +893,20 @@ static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(co
       g.uv.assign(4, Vec2f{});
       for (size_t k = 0; k < 4; ++k) g.uv[idx[k]] = corner[k];
     }
+    if (!bilinear && ps.has("N")) {
+      // pbrt-v4 refuses a count that is not one normal per point; so does tdpm.
+      const Param* np = ps.find("N");
+      if (np->type != "normal" && np->type != "normal3") ps.fail(*np, "expected type normal");
+      std::vector<double> N = ps.getFloats("N");
+      if (N.size() != 3 * P.size())
+        ps.fail(*np, "expected 3 numbers per point (" + std::to_string(3 * P.size()) + "), got " + std::to_string(N.size()));
+      for (size_t i = 0; i < N.size(); i += 3) g.normals.push_back({float(N[i]), float(N[i + 1]), float(N[i + 2])});
+    }
     for (const char* q : {"N", "S", "faceIndices"})
-      if (ps.has(q)) {
+      if (ps.has(q) && !(q[0] == 'N' && !bilinear)) {
         ps.markUsed(q);
-        note(std::string("Shape \"") + rec.type + "\": \"" + q + "\" ignored (tdpm shades with the geometric normal)");
+        note(std::string("Shape \"") + rec.type + "\": \"" + q + "\" ignored (tdpm shades " +
+             (q[0] == 'N' ? "its tessellated patches with their geometric normals)" : "without shading tangents / face indices)"));
       }
     g.vertices = P;
     if (!bilinear) {
@@ -921,10 +932,11 @@ static Geometry makeGeometry(const ShapeRecord& rec, const std::function<void(co
       std::string list;
       for (const std::string& q : ply.ignoredProperties) list += (list.empty() ? "\"" : ", \"") + q + "\"";
       note(std::string("Shape \"plymesh\": vertex ") + (ply.ignoredProperties.size() > 1 ? "properties " : "property ") + list +
-           " ignored (tdpm shades with the geometric normal)");
+           " ignored");
     }
     g.vertices = std::move(ply.vertices);
     g.uv = std::move(ply.uvs);
+    g.normals = std::move(ply.normals);
     g.indices = std::move(ply.triangles);
     addQuads(g.vertices, ply.quads, rec.at, "Shape \"plymesh\" \"" + file + "\"", &g.indices);
   } else if (rec.type == "loopsubdiv") {
@@ -1071,10 +1083,15 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
     // (the winding is kept through mirrors below), then ReverseOrientation.
     o.shape.reverseOrientation = rec.reverseOrientation;
     o.shape.indices = g.indices;
-    // A medium boundary's sides are pbrt's: shading normals N, when given,
-    // decide them per triangle (before the bake, which keeps the agreement).
-    if (rec.mediumInside != rec.mediumOutside && facesShadingNormals(rec, g.vertices, &o.shape.indices))
+    // With shading normals (N, nx ny nz) pbrt turns each triangle's normal to
+    // them and ignores ReverseOrientation: the windings are turned here
+    // (before the bake, which keeps the agreement), so sides (glass, media)
+    // are pbrt's and the renderer's "the geometric normal decides" holds.
+    const bool smooth = !g.normals.empty() && g.loopLevels < 0;
+    if (smooth) {
+      orientToNormals(g.normals, g.vertices, &o.shape.indices);
       o.shape.reverseOrientation = false;
+    }
     o.shape.loopLevels = g.loopLevels;  // placements are affine: refining after baking them is exact
     if (!plan.moving) {
       // Bake the placement into the vertices (any affine map is exact). A
@@ -1094,6 +1111,19 @@ void Importer::emitShape(const ShapeRecord& rec, const Mat ctm[2], const Loc& in
     // their vertex); loopsubdiv has none (its triangles are new).
     if (g.uv.size() == g.vertices.size() && g.loopLevels < 0)
       for (uint32_t i : o.shape.indices) o.shape.uvs.push_back(g.uv[i]);
+    // Shading normals per corner likewise, baked as normals (inverse
+    // transpose) with the vertices; a moving mesh keeps them in object space.
+    if (smooth) {
+      std::vector<Vec3f> N = g.normals;
+      if (!plan.moving)
+        for (Vec3f& n : N) n = plan.still.normal(n);
+      o.shape.normals.reserve(o.shape.indices.size());
+      for (uint32_t i : o.shape.indices) {
+        if (!std::isfinite(N[i].x) || !std::isfinite(N[i].y) || !std::isfinite(N[i].z))
+          failAt(rec.at, "Shape \"" + rec.type + "\": a normal is not finite after its transform");
+        o.shape.normals.push_back(N[i]);
+      }
+    }
   }
   o.material = mat.interface ? interfaceMaterialIndex() : materialIndex(rec.material);
   result.scene.objects.push_back(std::move(o));
@@ -1190,16 +1220,21 @@ void Importer::emitRoundLight(const ShapeRecord& rec, const Mat ctm[2]) {
 
 // Flips the windings that disagree with the triangle mesh's shading normals
 // N (object space); false (nothing done) when it has none.
-bool facesShadingNormals(const ShapeRecord& rec, const std::vector<Vec3f>& verts, std::vector<uint32_t>* indices) {
-  if (rec.type != "trianglemesh" || !rec.params.has("N")) return false;
-  std::vector<double> N = rec.params.getFloats("N");
-  if (N.size() != 3 * verts.size()) return false;  // pbrt would refuse; tdpm ignores N (noted)
-  auto n = [&](uint32_t i) { return Vec3f{float(N[3 * i]), float(N[3 * i + 1]), float(N[3 * i + 2])}; };
+void orientToNormals(const std::vector<Vec3f>& N, const std::vector<Vec3f>& verts, std::vector<uint32_t>* indices) {
   std::vector<uint32_t>& idx = *indices;
   for (size_t t = 0; t + 2 < idx.size(); t += 3) {
     Vec3f g = cross(verts[idx[t + 1]] - verts[idx[t]], verts[idx[t + 2]] - verts[idx[t]]);
-    if (dot(g, n(idx[t]) + n(idx[t + 1]) + n(idx[t + 2])) < 0) std::swap(idx[t + 1], idx[t + 2]);
+    if (dot(g, N[idx[t]] + N[idx[t + 1]] + N[idx[t + 2]]) < 0) std::swap(idx[t + 1], idx[t + 2]);
   }
+}
+
+bool facesShadingNormals(const ShapeRecord& rec, const std::vector<Vec3f>& verts, std::vector<uint32_t>* indices) {
+  if (rec.type != "trianglemesh" || !rec.params.has("N")) return false;
+  std::vector<double> N = rec.params.getFloats("N");
+  if (N.size() != 3 * verts.size()) return false;  // refused by makeGeometry before this is reached
+  std::vector<Vec3f> n(verts.size());
+  for (size_t i = 0; i < n.size(); ++i) n[i] = {float(N[3 * i]), float(N[3 * i + 1]), float(N[3 * i + 2])};
+  orientToNormals(n, verts, indices);
   return true;
 }
 

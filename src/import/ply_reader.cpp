@@ -188,19 +188,26 @@ PlyMesh parsePly(const std::string& bytes, const std::string& name) {
     if (minPer > 0 && e.count > body.remaining() / minPer)
       body.fail("element \"" + e.name + "\" claims " + std::to_string(e.count) + " entries, more than the file can hold");
     if (e.name == "vertex") {
-      int ix = -1, iy = -1, iz = -1, iu = -1, iv = -1;
+      int ix = -1, iy = -1, iz = -1, iu = -1, iv = -1, inx = -1, iny = -1, inz = -1;
       for (size_t i = 0; i < e.props.size(); ++i) {
         const Property& p = e.props[i];
         if (p.list) body.fail("vertex property \"" + p.name + "\" is a list");
         if (p.name == "x") ix = int(i);
         else if (p.name == "y") iy = int(i);
         else if (p.name == "z") iz = int(i);
+        else if (p.name == "nx") inx = int(i);
+        else if (p.name == "ny") iny = int(i);
+        else if (p.name == "nz") inz = int(i);
         // pbrt reads u/v, s/t or texture_u/texture_v (and _s/_t) as the uv.
         else if (iu < 0 && (p.name == "u" || p.name == "s" || p.name == "texture_u" || p.name == "texture_s")) iu = int(i);
         else if (iv < 0 && (p.name == "v" || p.name == "t" || p.name == "texture_v" || p.name == "texture_t")) iv = int(i);
         else mesh.ignoredProperties.push_back(p.name);
       }
       if (ix < 0 || iy < 0 || iz < 0) body.fail("the vertex element lacks x, y or z");
+      const bool normals = inx >= 0 && iny >= 0 && inz >= 0;  // pbrt reads them only as a triple
+      if (!normals)
+        for (int i : {inx, iny, inz})
+          if (i >= 0) mesh.ignoredProperties.push_back(e.props[size_t(i)].name);
       mesh.vertices.reserve(size_t(e.count));
       std::vector<double> v(e.props.size());
       for (uint64_t k = 0; k < e.count; ++k) {
@@ -213,6 +220,12 @@ PlyMesh parsePly(const std::string& bytes, const std::string& name) {
           Vec2f uv{float(v[size_t(iu)]), float(v[size_t(iv)])};
           if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) body.fail("vertex " + std::to_string(k) + "'s (u, v) is not finite");
           mesh.uvs.push_back(uv);
+        }
+        if (normals) {
+          Vec3f n{float(v[size_t(inx)]), float(v[size_t(iny)]), float(v[size_t(inz)])};
+          if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z))
+            body.fail("vertex " + std::to_string(k) + "'s normal (nx, ny, nz) is not finite");
+          mesh.normals.push_back(n);
         }
       }
       if (iu >= 0 && iv < 0) mesh.ignoredProperties.push_back(e.props[size_t(iu)].name);

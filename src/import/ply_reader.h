@@ -16,6 +16,7 @@ namespace tdpm::pbrt {
 struct PlyMesh {
   std::vector<Vec3f> vertices;
   std::vector<Vec2f> uvs;                    // per vertex (u/v, s/t), or empty
+  std::vector<Vec3f> normals;                // per vertex (nx, ny, nz), or empty
   std::vector<uint32_t> triangles;           // 3 per triangle
   std::vector<uint32_t> quads;               // 4 per quad, in the file's corner order
   std::vector<std::string> ignoredProperties;  // e.g. nx, u: read but not used

@@ -110,11 +110,13 @@ struct Affine3f {
     return r;
   }
   // Normals transform by the inverse transpose.
-  Vec3f normal(Vec3f n) const {
-    Affine3f inv = inverse();
-    return {inv.m[0][0] * n.x + inv.m[1][0] * n.y + inv.m[2][0] * n.z,
-            inv.m[0][1] * n.x + inv.m[1][1] * n.y + inv.m[2][1] * n.z,
-            inv.m[0][2] * n.x + inv.m[1][2] * n.y + inv.m[2][2] * n.z};
+  Vec3f normal(Vec3f n) const { return inverse().transposedVector(n); }
+  // The 3x3 part's transpose times v: a normal's transform when this is the
+  // inverse placement (as normal(), without its inverse per call).
+  Vec3f transposedVector(Vec3f v) const {
+    return {m[0][0] * v.x + m[1][0] * v.y + m[2][0] * v.z,
+            m[0][1] * v.x + m[1][1] * v.y + m[2][1] * v.z,
+            m[0][2] * v.x + m[1][2] * v.y + m[2][2] * v.z};
   }
 };
 

@@ -541,6 +541,8 @@ struct Tracer {
       BsdfSample bs;
       Vec3f ub = rng.get3D(dims::vertexGroup(bounce, dims::kBsdf));
       if (!bsdfSample(ctx, {ub.x, ub.y}, ub.z, Transport::Importance, bs)) return rays;
+      // Shading normals: the adjoint BSDF (bsdf.h), before the roulette reads the weight.
+      if (ctx.shaded) bs.weight = bs.weight * adjointShadingFactor(ctx, -dir, bs.wi);
       bool specularLike = bs.delta || glossyBounce;
       if (settings.kind == MapKind::Caustic && !specularLike) return rays;
       allSpecular = allSpecular && specularLike;

@@ -95,6 +95,8 @@ uint64_t walkPhotonInMedia(const Scene& scene, const TraceSettings& settings, co
     BsdfSample bs;
     Vec3f ub = rng.get3D(dims::vertexGroup(bounce, dims::kBsdf));
     if (!bsdfSample(ctx, {ub.x, ub.y}, ub.z, Transport::Importance, bs)) return rays;
+    // Shading normals: the adjoint BSDF (bsdf.h), before the roulette reads the weight.
+    if (ctx.shaded) bs.weight = bs.weight * adjointShadingFactor(ctx, -dir, bs.wi);
     bool specularLike = bs.delta || glossyBounce;
     if (caustic && !specularLike) return rays;
     allSpecular = allSpecular && specularLike;

@@ -89,44 +89,50 @@ Rgb PhotonIntegrator::estimate(const PhotonMap* map, std::unique_ptr<estimate::G
                                float minVolume) const {
   if (!map || map->size() == 0) return Rgb(0.0f);
   EstimateCounts& counts = ts.counts;
-  auto brdf = [&ctx](Vec3f wi, Vec3f) { return bsdfEval(ctx, wi); };
-  Vec3f n = ctx.frame.n;  // faces the viewer: photons from the other side do not count
-  // Nor do photons on the other side of this object's surface, which the
-  // side test alone lets through convex edges and thin parts of closed
-  // objects (photon/surface_tag.h).
-  uint8_t tag = photon::surfaceTag(hit.object, dot(hit.n, wo) < 0.0f);
-  if (s_.fixedKernels) {
-    if (!ts.fixed) ts.fixed = std::make_unique<estimate::FixedKernelGatherer>();
-    const estimate::MapKernel& k = s_.kernels[kindOf(map)];
+  // The gather, for one BSDF functor (instantiated twice: a context without
+  // a shading normal keeps exactly its old loop, no branch per photon).
+  auto gather = [&](const auto& brdf) -> Rgb {
+    Vec3f n = ctx.frame.n;  // faces the viewer: photons from the other side do not count
+    // Nor do photons on the other side of this object's surface, which the
+    // side test alone lets through convex edges and thin parts of closed
+    // objects (photon/surface_tag.h).
+    uint8_t tag = photon::surfaceTag(hit.object, dot(hit.n, wo) < 0.0f);
+    if (s_.fixedKernels) {
+      if (!ts.fixed) ts.fixed = std::make_unique<estimate::FixedKernelGatherer>();
+      const estimate::MapKernel& k = s_.kernels[kindOf(map)];
+      if (timeDependent) {
+        ++counts.timeDependent;
+        float t = scene_.shutter.instant() ? map->store.t0() : scene_.shutter.fromNormalized(time01);
+        return ts.fixed->spaceTime(map->tree, hit.p, n, wo, t, k.radius, k.halfWindow, brdf, tag);
+      }
+      ++counts.standard;
+      return ts.fixed->spatial(map->spatialTree(), hit.p, n, wo, k.spatialRadius, brdf, tag);
+    }
     if (timeDependent) {
       ++counts.timeDependent;
+      if (!g) {
+        estimate::Options o = s_.estimate;
+        o.method = s_.spaceTime4D ? estimate::Method::SpaceTime4D : estimate::Method::TimeTwoPass;
+        g = std::make_unique<estimate::Gatherer>(map->tree, o);
+      }
       float t = scene_.shutter.instant() ? map->store.t0() : scene_.shutter.fromNormalized(time01);
-      return ts.fixed->spaceTime(map->tree, hit.p, n, wo, t, k.radius, k.halfWindow, brdf, tag);
+      Rgb L = g->radiance(hit.p, n, wo, t, brdf, nullptr, tag, minVolume);
+      countEstimate(counts, kindOf(map), g->lastSummed());
+      return L;
     }
     ++counts.standard;
-    return ts.fixed->spatial(map->spatialTree(), hit.p, n, wo, k.spatialRadius, brdf, tag);
-  }
-  if (timeDependent) {
-    ++counts.timeDependent;
-    if (!g) {
+    if (!g3) {
       estimate::Options o = s_.estimate;
-      o.method = s_.spaceTime4D ? estimate::Method::SpaceTime4D : estimate::Method::TimeTwoPass;
-      g = std::make_unique<estimate::Gatherer>(map->tree, o);
+      o.method = estimate::Method::Standard;
+      g3 = std::make_unique<estimate::Gatherer>(map->spatialTree(), o);
     }
-    float t = scene_.shutter.instant() ? map->store.t0() : scene_.shutter.fromNormalized(time01);
-    Rgb L = g->radiance(hit.p, n, wo, t, brdf, nullptr, tag, minVolume);
-    countEstimate(counts, kindOf(map), g->lastSummed());
+    Rgb L = g3->standard(hit.p, n, wo, brdf, nullptr, tag);
+    countEstimate(counts, kindOf(map), g3->lastSummed());
     return L;
-  }
-  ++counts.standard;
-  if (!g3) {
-    estimate::Options o = s_.estimate;
-    o.method = estimate::Method::Standard;
-    g3 = std::make_unique<estimate::Gatherer>(map->spatialTree(), o);
-  }
-  Rgb L = g3->standard(hit.p, n, wo, brdf, nullptr, tag);
-  countEstimate(counts, kindOf(map), g3->lastSummed());
-  return L;
+  };
+  if (!ctx.shaded) return gather([&ctx](Vec3f wi, Vec3f) { return bsdfEval(ctx, wi); });
+  // At a shading normal each photon's f also takes |wi.ns| / |wi.ng| (bsdf.h).
+  return gather([&ctx](Vec3f wi, Vec3f) { return bsdfEval(ctx, wi) * gatherShadingFactor(ctx, wi); });
 }
 
 // True if direction w from p points at a light (see kTowardLightCos).

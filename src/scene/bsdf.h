@@ -7,6 +7,8 @@
 // makeShadingFrame is the outward geometric normal; opaque materials are
 // two-sided (the frame is flipped to wo's side), dielectrics are not.
 #pragma once
+#include <cmath>
+
 #include "math/frame.h"
 #include "math/vec.h"
 #include "scene/material.h"
@@ -49,6 +51,27 @@ ShadingContext makeShadingContext(const Material& m, Rgb albedo, Vec3f outwardNo
 // normal (a grazing view of a steep bump), the geometric frame is used:
 // the BSDFs see wo below their surface there and would give black.
 ShadingContext makeShadingContext(const Material& m, Rgb albedo, Vec3f outwardNormal, Vec3f woWorld, Vec3f ns);
+
+// Photons through shading normals (vertex normals, bump and normal maps):
+// the BSDF is not symmetric there, and light paths need Veach's adjoint
+// (thesis sec. 5.3; pbrt-v3's CorrectShadingNormal). A photon arriving from
+// wPrev (unit, pointing away from the surface) and leaving along wNext
+// carries bsdfSample's weight times |wPrev.ns| |wNext.ng| / (|wPrev.ng|
+// |wNext.ns|); 1 without a shading normal (or 0 where it vanishes).
+inline float adjointShadingFactor(const ShadingContext& c, Vec3f wPrev, Vec3f wNext) {
+  if (!c.shaded) return 1.0f;
+  float num = std::fabs(dot(wPrev, c.frame.n)) * std::fabs(dot(wNext, c.ng));
+  float den = std::fabs(dot(wPrev, c.ng)) * std::fabs(dot(wNext, c.frame.n));
+  return den > 0 ? num / den : 0.0f;
+}
+// A photon density estimate's BSDF at a shading normal: stored photons are
+// flux through the geometric surface (|wi.ng| dA), the radiance integral
+// weighs incident light by |wi.ns|: f |wi.ns| / |wi.ng| (1 when !shaded).
+inline float gatherShadingFactor(const ShadingContext& c, Vec3f wi) {
+  if (!c.shaded) return 1.0f;
+  float den = std::fabs(dot(wi, c.ng));
+  return den > 0 ? std::fabs(dot(wi, c.frame.n)) / den : 0.0f;
+}
 
 struct BsdfSample {
   Vec3f wi;        // world

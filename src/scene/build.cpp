@@ -23,6 +23,7 @@ struct TriangleMesh {
   std::vector<Vec3f> vertices;
   std::vector<uint32_t> indices;
   std::vector<Vec2f> uvs;  // per corner, or empty
+  std::vector<Vec3f> normals;  // shading normals per corner, or empty
 };
 
 // Quad in the local x-z plane, normal +y (counter-clockwise seen from +y).
@@ -32,7 +33,8 @@ TriangleMesh makeQuad(float sx, float sz) {
   // with -z up (its top row at z = -sz / 2).
   return {{{-x, 0, -z}, {-x, 0, z}, {x, 0, z}, {x, 0, -z}},
           {0, 1, 2, 0, 2, 3},
-          {{0, 1}, {0, 0}, {1, 0}, {0, 1}, {1, 0}, {1, 1}}};
+          {{0, 1}, {0, 0}, {1, 0}, {0, 1}, {1, 0}, {1, 1}},
+          {}};
 }
 
 // Axis-aligned box centred at the origin, outward-facing triangles.
@@ -431,7 +433,7 @@ uint32_t addEmitterShape(EmbreeScene& embree, const Light& l, Bounds3f& local) {
       local = {{-l.radius, 0, -l.radius}, {l.radius, 0, l.radius}};
       return embree.addOrientedDisc(centres, l.stepNormal, l.stepRadius);
     case Light::AreaShape::Mesh: {
-      TriangleMesh m{l.mesh->vertices, l.mesh->indices};
+      TriangleMesh m{l.mesh->vertices, l.mesh->indices, {}, {}};
       if (!l.motion.moving()) return embree.addTriangles(m.vertices, m.indices);  // world vertices
       for (Vec3f v : m.vertices) local.extend(v);
       return addMesh(embree, l.motion, m);
@@ -533,14 +535,15 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
             // parse.cpp and the pbrt import checked topology and budget.
             scene::LoopMesh refined = scene::loopSubdivide(od.shape.vertices, od.shape.indices, od.shape.loopLevels,
                                              scene::limits::kMaxSubdividedTriangles);
-            mesh = {std::move(refined.vertices), std::move(refined.indices)};
+            mesh = {std::move(refined.vertices), std::move(refined.indices), {}, {}};
           } else {
-            mesh = {od.shape.vertices, od.shape.indices, od.shape.uvs};
+            mesh = {od.shape.vertices, od.shape.indices, od.shape.uvs, od.shape.normals};
           }
           break;
       }
       for (Vec3f v : mesh.vertices) o.objectBounds.extend(v);
       if (mesh.uvs.size() == mesh.indices.size()) o.uvs = std::move(mesh.uvs);
+      if (mesh.normals.size() == mesh.indices.size()) o.normals = std::move(mesh.normals);
       if (shadingNormals) triangleTangents(mesh, o);
       o.faceNormals.reserve(mesh.indices.size() / 3);
       for (size_t i = 0; i < mesh.indices.size(); i += 3) {
@@ -560,6 +563,10 @@ std::unique_ptr<Scene> Scene::build(const scene::SceneDescription& desc) {
       o.inversePlacement = m.inverse();
       o.worldNormals.reserve(o.faceNormals.size());
       for (Vec3f n : o.faceNormals) o.worldNormals.push_back(normalize(m.normal(n)));
+      // Shading normals to world space once, as normals and not normalised
+      // (the transform is linear, so interpolating them afterwards is
+      // interpolating in object space; pbrt transforms them at load too).
+      for (Vec3f& n : o.normals) n = o.inversePlacement.transposedVector(n);
     }
     o.sweptBounds = o.motion.sweptBounds(o.objectBounds);
     s.bounds.extend(o.sweptBounds);

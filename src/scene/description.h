@@ -210,6 +210,10 @@ struct ShapeDesc {
   // Mesh: (u, v) per triangle corner (3 per triangle, as indices), or empty:
   // each triangle gets pbrt's default (0,0), (1,0), (1,1).
   std::vector<Vec2f> uvs;
+  // Mesh: shading normals per triangle corner (3 per triangle, as uvs; OBJ
+  // vn, pbrt "N", PLY nx/ny/nz), object space as given (not normalised:
+  // pbrt interpolates them as they are), or empty: the geometric normal.
+  std::vector<Vec3f> normals;
 };
 
 struct ObjectDesc {

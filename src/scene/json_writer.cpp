@@ -261,9 +261,16 @@ std::string objText(const scene::ShapeDesc& s) {
   const bool uv = s.uvs.size() == s.indices.size();
   if (uv)
     for (Vec2f t : s.uvs) out += "vt " + objNumber(t.x) + " " + objNumber(t.y) + "\n";
-  // With uv, corner k of the file's faces is vt k + 1 (one vt per corner).
+  const bool normals = s.normals.size() == s.indices.size();
+  if (normals)
+    for (Vec3f n : s.normals) out += "vn " + objNumber(n.x) + " " + objNumber(n.y) + " " + objNumber(n.z) + "\n";
+  // With uv, corner k of the file's faces is vt k + 1 (one vt per corner);
+  // with normals, vn k + 1 likewise.
   auto corner = [&](size_t k) {
-    return std::to_string(s.indices[k] + 1) + (uv ? "/" + std::to_string(k + 1) : std::string());
+    std::string c = std::to_string(s.indices[k] + 1);
+    if (uv || normals) c += "/" + (uv ? std::to_string(k + 1) : std::string());
+    if (normals) c += "/" + std::to_string(k + 1);
+    return c;
   };
   for (size_t i = 0; i + 2 < s.indices.size(); i += 3) out += "f " + corner(i) + " " + corner(i + 1) + " " + corner(i + 2) + "\n";
   return out;

@@ -161,7 +161,7 @@ bool precheck(const std::string& path, const std::string& name, std::vector<size
 // Appends one polygon's triangles; false (with `problem`) on a bad index.
 bool addPolygon(const tinyobj::index_t* corners, size_t n, size_t face, size_t vertexCount, ObjMesh* mesh,
                 const std::vector<size_t>& faceLines, std::string* problem, const tinyobj::attrib_t& attrib,
-                bool* allUv) {
+                bool* allUv, bool* allNormals) {
   for (size_t k = 0; k < n; ++k) {
     int v = corners[k].vertex_index;
     if (v < 0 || size_t(v) >= vertexCount) {
@@ -183,11 +183,27 @@ bool addPolygon(const tinyobj::index_t* corners, size_t n, size_t face, size_t v
       return false;
     }
   }
+  const size_t normalCount = attrib.normals.size() / 3;
+  for (size_t k = 0; k < n && *allNormals; ++k) {
+    int t = corners[k].normal_index;
+    if (t < 0) *allNormals = false;  // a face without vn: the geometric normal for the mesh
+    else if (size_t(t) >= normalCount) {
+      *problem = (face < faceLines.size() ? "line " + std::to_string(faceLines[face]) + ": " : std::string()) + "face " +
+                 std::to_string(face + 1) + " uses normal " + std::to_string(int64_t(t) + 1) +
+                 " but the file has " + std::to_string(normalCount);
+      return false;
+    }
+  }
+  auto normal = [&](const tinyobj::index_t& c) {
+    const size_t i = 3 * size_t(c.normal_index);
+    return Vec3f{float(attrib.normals[i]), float(attrib.normals[i + 1]), float(attrib.normals[i + 2])};
+  };
   auto uv = [&](const tinyobj::index_t& c) {
     return Vec2f{float(attrib.texcoords[2 * size_t(c.texcoord_index)]), float(attrib.texcoords[2 * size_t(c.texcoord_index) + 1])};
   };
   for (size_t k = 1; k + 1 < n; ++k) {
     if (*allUv) mesh->uvs.insert(mesh->uvs.end(), {uv(corners[0]), uv(corners[k]), uv(corners[k + 1])});
+    if (*allNormals) mesh->normals.insert(mesh->normals.end(), {normal(corners[0]), normal(corners[k]), normal(corners[k + 1])});
     mesh->indices.push_back(uint32_t(corners[0].vertex_index));
     mesh->indices.push_back(uint32_t(corners[k].vertex_index));
     mesh->indices.push_back(uint32_t(corners[k + 1].vertex_index));
@@ -212,17 +228,18 @@ bool collectVertices(const tinyobj::attrib_t& attrib, ObjMesh* mesh, std::string
 bool collectFaces(const std::vector<tinyobj::shape_t>& shapes, const tinyobj::attrib_t& attrib, ObjMesh* mesh,
                   const std::vector<size_t>& faceLines, std::string* problem) {
   size_t face = 0;
-  bool allUv = true;
+  bool allUv = true, allNormals = true;
   for (const auto& shape : shapes) {
     size_t offset = 0;
     for (size_t n : shape.mesh.num_face_vertices) {
       if (!addPolygon(&shape.mesh.indices[offset], n, face++, mesh->vertices.size(), mesh, faceLines, problem, attrib,
-                      &allUv))
+                      &allUv, &allNormals))
         return false;
       offset += n;
     }
   }
   if (!allUv || mesh->uvs.size() != mesh->indices.size()) mesh->uvs.clear();
+  if (!allNormals || mesh->normals.size() != mesh->indices.size()) mesh->normals.clear();
   return true;
 }
 

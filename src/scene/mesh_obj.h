@@ -16,10 +16,13 @@ struct ObjMesh {
   // (u, v) per triangle corner from the faces' vt indices, when every face
   // has them (else empty: the renderer's default per triangle).
   std::vector<Vec2f> uvs;
+  // Shading normals per triangle corner from the faces' vn indices, when
+  // every face has them (else empty: the geometric normal).
+  std::vector<Vec3f> normals;
 };
 
 // Loads every face of every group of `path`, triangulated (polygons are
-// split; vt texture coordinates kept, normals/materials ignored). On failure returns false and sets
+// split; vt texture coordinates and vn normals kept, materials ignored). On failure returns false and sets
 // `problem` to a message naming the file, e.g.
 //   mesh "meshes/bad.obj": face 3 uses vertex 9 but the file has 4 vertices
 bool loadObjMesh(const std::string& path, ObjMesh* mesh, std::string* problem);

@@ -941,9 +941,11 @@ void readMesh(const Node& n, const std::string& sceneDir, ShapeDesc* shape) {
   shape->vertices = std::move(mesh.vertices);
   shape->indices = std::move(mesh.indices);
   shape->uvs = std::move(mesh.uvs);
+  shape->normals = std::move(mesh.normals);
   if (n.has("subdivision")) {
     readSubdivision(n.member("subdivision"), shape);
     shape->uvs.clear();  // the refined triangles are new: pbrt's default uv each
+    shape->normals.clear();  // and their geometric normals (docs/scene-format.md)
   }
 }
 

@@ -36,6 +36,11 @@ struct SceneObject {
   Bounds3f sweptBounds;             // world, over the whole shutter
   std::vector<Vec3f> faceNormals;   // triangles: object-space unit normals
   std::vector<Vec2f> uvs;           // triangles: (u, v) per corner, or empty (pbrt's default per triangle)
+  // Triangles: shading normals per corner (scene::ShapeDesc::normals), or
+  // empty (the geometric normal shades). World space (inverse transpose of
+  // the placement, not normalised) when the object is still, object space
+  // when it moves (Scene::interpolatedNormal transforms them per hit).
+  std::vector<Vec3f> normals;
   // Triangles, only in scenes with shading normals (bump / normal maps):
   // object-space dp/du and dp/dv per triangle (pbrt's Triangle, from uvs).
   std::vector<Vec3f> dpdu, dpdv;
@@ -101,26 +106,33 @@ class Scene {
   }
   // The shading context at a hit on an object for the material materialAt
   // gave (textured parameters in `scratch`, as shadedMaterial): its frame
-  // about the geometric normal, or the bumped / normal-mapped shading normal
-  // when the material has one (scene/shading_normal.cpp). Every integrator
+  // about the geometric normal, or about the shading normal when the mesh
+  // has vertex normals or the material a bump / normal map
+  // (scene/shading_normal.cpp). Every integrator
   // builds its contexts here, so shading normals apply everywhere.
   // mixWeight: what materialAt gave for a per-channel mix (1 otherwise).
   ShadingContext shadingContext(const Material& m, const Hit& hit, Vec3f wo, std::optional<Material>& scratch,
                                 Rgb mixWeight = Rgb(1.0f)) const {
     ShadingContext c =
-        m.hasShadingNormal()
-            ? makeShadingContext(shadedMaterial(m, hit, scratch), albedoAt(m, hit), hit.n, wo, shadingNormal(m, hit))
-            : makeShadingContext(shadedMaterial(m, hit, scratch), albedoAt(m, hit), hit.n, wo);
+        !m.hasShadingNormal() && objects[hit.object].normals.empty()
+            ? makeShadingContext(shadedMaterial(m, hit, scratch), albedoAt(m, hit), hit.n, wo)
+            : makeShadingContext(shadedMaterial(m, hit, scratch), albedoAt(m, hit), hit.n, wo, shadingNormal(m, hit));
     if (mixWeight.r != 1.0f || mixWeight.g != 1.0f || mixWeight.b != 1.0f) {
       c.mixWeighted = true;
       c.mixWeight = mixWeight;
     }
     return c;
   }
-  // The material's shading normal at the hit (unit, on hit.n's side):
-  // pbrt-v4's BumpMap (the displaced surface's dp/du x dp/dv) or NormalMap
-  // (the map's tangent-space normal in the frame of dp/du and the normal).
+  // The shading normal at the hit (unit, on hit.n's side): the mesh's
+  // interpolated vertex normals when it has them (else hit.n), perturbed by
+  // the material's bump or normal map as pbrt-v4 does: BumpMap (the
+  // displaced surface's dp/du x dp/dv) or NormalMap (the map's tangent-space
+  // normal in the frame of dp/du and the normal).
   Vec3f shadingNormal(const Material& m, const Hit& hit) const;
+  // A mesh hit's vertex normals blended by its barycentrics, in world space,
+  // unit, on hit.n's side (pbrt-v4's Triangle: ns = b0 n0 + b1 n1 + b2 n2,
+  // normalised); hit.n where the blend vanishes. Only for objects with normals.
+  Vec3f interpolatedNormal(const Hit& hit) const;
   // World-space dp/du, dp/dv at a hit on an object, pbrt's for each shape
   // (triangles: from their (u, v), or a frame about the normal when those
   // are degenerate). Triangles need the tangents built (scene with shading normals).

@@ -1,8 +1,10 @@
-// scene/shading_normal.cpp — shading normals from bump and normal maps
+// scene/shading_normal.cpp — shading normals: meshes' interpolated vertex
+// normals (pbrt-v4's Triangle), bump and normal maps on top of them
 // (pbrt-v4's BumpMap and NormalMap, materials.h), and the surface tangents
-// dp/du, dp/dv they are built from (pbrt's Sphere, Disk, Cylinder and
-// Triangle). Only materials with a bump or a normal map reach this file;
-// every other hit keeps the geometric frame (Scene::shadingContext).
+// dp/du, dp/dv the maps are built from (pbrt's Sphere, Disk, Cylinder and
+// Triangle). Only meshes with normals and materials with a bump or a normal
+// map reach this file; every other hit keeps the geometric frame
+// (Scene::shadingContext).
 #include <algorithm>
 #include <cmath>
 
@@ -71,10 +73,44 @@ void Scene::surfaceTangents(const Hit& hit, Vec3f* dpdu, Vec3f* dpdv) const {
   *dpdv = m.vector(*dpdv);
 }
 
+Vec3f Scene::interpolatedNormal(const Hit& hit) const {
+  const SceneObject& obj = objects[hit.object];
+  const Vec3f* c = &obj.normals[size_t(hit.primitive) * 3];
+  const float b1 = hit.bary.x, b2 = hit.bary.y;
+  // b0 c0 + b1 c1 + b2 c2 in lerp form: where the three corners are equal
+  // the blend is that corner exactly, so normals equal to the face normals
+  // give hit.n to the bit (and the image of the mesh without them).
+  Vec3f n = c[0] + (c[1] - c[0]) * b1 + (c[2] - c[0]) * b2;
+  // Moving: object space, transformed as Scene::intersect transforms hit.n.
+  if (obj.motion.moving()) n = obj.motion.atNormalized(hit.time01).inverse().transposedVector(n);
+  if (!(lengthSquared(n) > 0) || !std::isfinite(n.x + n.y + n.z)) return hit.n;
+  n = normalize(n);
+  // The geometric normal decides sides (the import turns windings to agree
+  // with N as pbrt does; an OBJ's winding decides for its vn).
+  return dot(n, hit.n) < 0 ? -n : n;
+}
+
 Vec3f Scene::shadingNormal(const Material& mat, const Hit& hit) const {
+  const bool smooth = !objects[hit.object].normals.empty();
+  if (!mat.hasShadingNormal()) return smooth ? interpolatedNormal(hit) : hit.n;  // vertex normals or none
   Vec3f dpdu, dpdv;
   surfaceTangents(hit, &dpdu, &dpdv);
-  const Vec3f n = hit.n;  // pbrt's n: the shape's orientation, ReverseOrientation applied
+  const Vec3f ng = hit.n;  // pbrt's n: the shape's orientation, ReverseOrientation applied
+  Vec3f n = ng;            // the frame the map perturbs: pbrt-v4's shading.n
+  if (smooth) {
+    // pbrt-v4's Triangle shading frame about the interpolated normal:
+    // ts = ns x dp/du, ss = ts x ns (dp/du made perpendicular to ns).
+    n = interpolatedNormal(hit);
+    Vec3f ts = cross(n, dpdu);
+    if (lengthSquared(ts) > 0) {
+      dpdu = cross(ts, n);
+      dpdv = ts;
+    } else {
+      Frame f(n);
+      dpdu = f.s;
+      dpdv = f.t;
+    }
+  }
   Vec3f ns;
   if (mat.normalMapImage >= 0) {
     // pbrt-v4's NormalMap: the texel (2 c - 1, unit) in the frame x =
@@ -99,7 +135,7 @@ Vec3f Scene::shadingNormal(const Material& mat, const Hit& hit) const {
     // renders bit for bit as no map.
     ns = x * t.x + y * t.y + n * t.z;
     if (!std::isfinite(ns.x + ns.y + ns.z)) return n;
-    return dot(ns, n) < 0 ? -ns : ns;
+    return dot(ns, ng) < 0 ? -ns : ns;
   } else {
     // pbrt-v4's BumpMap: dp/du' = dp/du + (d(u + du) - d(u)) / du n (the
     // displacement's dn/du term is left out: tdpm's shapes carry no dn/du;
@@ -120,7 +156,7 @@ Vec3f Scene::shadingNormal(const Material& mat, const Hit& hit) const {
   float l = length(ns);
   if (!(l > 0) || !std::isfinite(l)) return n;
   ns = ns / l;
-  return dot(ns, n) < 0 ? -ns : ns;  // pbrt: FaceForward(ns, n)
+  return dot(ns, ng) < 0 ? -ns : ns;  // pbrt: FaceForward(ns, n)
 }
 
 }  // namespace tdpm
