@@ -459,6 +459,11 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_option("--moving-photons", a.movingPhotons, "With --shared-photons: each frame traces this many times its "
                 "paths for the photons whose path meets motion (default " + shortNumber(AnimationOptions{}.movingScale) + ")")
       ->check(CLI::Range(0.001, 1000.0))->group(animationGroup);
+  c->add_flag("--continue-paths,!--no-continue-paths", a.continuePaths,
+              "With --shared-photons: each frame continues the block's photon paths that meet motion from their "
+              "last time-invariant vertex instead of tracing its paths from the light (default: " +
+                  std::string(AnimationOptions{}.continuePaths ? "on" : "off") + ")")
+      ->group(animationGroup);
   addProgressiveOptions(c, a);
   return c;
 }
@@ -584,13 +589,15 @@ ProgressiveState startProgressiveState(const RenderArgs& a, const RenderSetup& s
 
 // The animation flags on a scene without an animation block.
 void refuseAnimationFlags(const RenderArgs& a, bool framePattern) {
-  if (framePattern || a.frameRange || a.video || a.window || a.independentFrames || a.sharedPhotons || a.movingPhotons)
+  if (framePattern || a.frameRange || a.video || a.window || a.independentFrames || a.sharedPhotons || a.movingPhotons ||
+      a.continuePaths)
     throw Error(std::string(framePattern ? "--output: a frame-number pattern (#)"
                             : a.frameRange ? "--frame-range"
                             : a.video      ? "--video"
                             : a.window     ? "--window"
                             : a.sharedPhotons ? "--shared-photons"
                             : a.movingPhotons ? "--moving-photons"
+                            : a.continuePaths ? (*a.continuePaths ? "--continue-paths" : "--no-continue-paths")
                                            : "--independent-frames") +
                 " needs an animation, but " + a.scene + " has no \"animation\" block (docs/scene-format.md)");
 }
