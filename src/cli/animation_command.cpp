@@ -306,7 +306,7 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
   ao.independentFrames = a.independentFrames;
   ao.sharedScale = a.sharedPhotons.value_or(ao.sharedScale);
   ao.movingScale = a.movingPhotons.value_or(ao.movingScale);
-  ao.continuePaths = a.continuePaths.value_or(ao.continuePaths);
+  if (a.continuePaths || a.noContinuePaths) ao.continuePaths = a.continuePaths;
   std::vector<FrameLine> lines;
   uint64_t peakRss = 0;
   Timer frameTimer;

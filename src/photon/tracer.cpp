@@ -26,7 +26,6 @@ namespace tdpm::photon {
 
 namespace {
 
-constexpr uint32_t kPilotBatches = 16;
 // Photon bounces whose Sobol group seeds are hashed once per batch (deeper
 // bounces hash theirs per draw, as the eye paths do): groups up to the
 // roulette slot of vertex kSeedTableBounces.
@@ -830,7 +829,7 @@ TraceResult traceMap(const Scene& scene, const TraceSettings& settings, const Tr
   // Distributed, every rank traces its block of each round and the counts
   // are summed (integers), so every rank takes the same decisions.
   dist::Comm& comm = *settings.comm;
-  uint64_t pilotBatches = kPilotBatches;
+  uint64_t pilotBatches = std::max<uint32_t>(1, settings.pilotBatches);
   size_t stored = 0;
   uint64_t pilotRays = 0;
   for (;;) {

@@ -94,6 +94,9 @@ struct TraceSettings {
   // state before the first segment that does (TraceResult::kept), so that
   // frames can continue it at their own times (continuePaths).
   bool keepMoving = false;
+  // The pilot's first round, in batches (it grows 8x a round while nothing
+  // is stored): the stored photons per path it measures size the emission.
+  uint32_t pilotBatches = 16;
 };
 
 // A path of a block's pass (InvariantPhotons::Only, keepMoving) at its last

@@ -396,6 +396,12 @@ class SegmentTimeline {
   // over bins [lo, hi).
   double pilotRate(int64_t lo, int64_t hi, MapKind kind, uint64_t seed) {
     photon::TraceSettings ts = traceSettingsFor(opt_, kind, 1, seed);
+    // Continuing (section 8): the block's pilot is most of what is left of
+    // the frames' photon cost besides the shared set (16 batches per kind
+    // against a global set of 3 in still-room); 4 batches measure the rate
+    // to a few percent, which only sizes the counts (energies use the
+    // emitted paths).
+    if (continuing()) ts.pilotBatches = 4;
     ts.timeOpen = float(double(lo) * grid_.binWidth);
     ts.timeClose = float(double(hi) * grid_.binWidth);
     photon::TraceResult r = photon::tracePhotons(scene_, ts, Progress{});
