@@ -620,7 +620,15 @@ struct Tracer {
       });
       all.appendBatches(parts);
       for (const std::vector<ExitPoint>& e : partExits) exitsOut->insert(exitsOut->end(), e.begin(), e.end());
-      for (const std::vector<PathState>& k : partKept) keptOut->insert(keptOut->end(), k.begin(), k.end());
+      if (keptOut) {  // grown once per chunk, to its size: no doubling slack on top of the parts
+        size_t n = keptOut->size();
+        for (const std::vector<PathState>& k : partKept) n += k.size();
+        keptOut->reserve(n);
+        for (std::vector<PathState>& k : partKept) {
+          keptOut->insert(keptOut->end(), k.begin(), k.end());
+          std::vector<PathState>().swap(k);
+        }
+      }
     }
     if (raysOut) *raysOut = rays.load();
     return all;
@@ -888,6 +896,7 @@ TraceResult traceMap(const Scene& scene, const TraceSettings& settings, const Tr
                                        settings.keepMoving ? &result.kept.states : nullptr);
   }
   if (settings.keepMoving) {
+    result.kept.states.shrink_to_fit();  // held for the block: not the growth's slack
     result.kept.emitted = result.emitted;
     result.kept.sobolSeed = hashCombine(settings.seed, uint64_t(settings.kind) + 1, 0x9407ull);
   }
@@ -946,6 +955,7 @@ TraceResult continuePaths(const Scene& scene, const TraceSettings& settings, con
   // The kept states whose block path some virtual path j takes, in j order
   // within each pass over the block's paths (states are in path order).
   std::vector<ContinuedPath> work;
+  work.reserve(std::min<uint64_t>(kept.states.size(), c.virtualPaths));
   for (uint64_t v = c.firstVirtual, end = c.firstVirtual + c.virtualPaths; v < end;) {
     const uint64_t round = v / n, a = v % n, b = std::min(n, a + (end - v));
     auto byIndex = [](const PathState& st, uint64_t i) { return st.pathIndex < i; };
