@@ -20,6 +20,7 @@
 #include "cli/frame_pattern.h"
 #include "cli/path_names.h"
 #include "distributed/comm.h"
+#include "photon/tracer.h"
 #include "cli/progress_bar.h"
 #include "cli/render_metadata.h"
 #include "core/atomic_file.h"
@@ -260,6 +261,10 @@ void printAnimationSummary(const RenderArgs& a, const RenderOptions& opt, const 
     if (stats.sharedSets > 0)
       std::fprintf(stderr, "  time-invariant photons: %zu stored in %llu shared sets\n", stats.sharedPhotons,
                    static_cast<unsigned long long>(stats.sharedSets));
+    if (stats.continuedPaths > 0 || stats.peakKeptStates > 0)
+      std::fprintf(stderr, "  continued paths: %llu of the segments' paths continued from kept states (at most %zu held, %zu bytes)\n",
+                   static_cast<unsigned long long>(stats.continuedPaths), stats.peakKeptStates,
+                   stats.peakKeptStates * sizeof(photon::PathState));
   }
 }
 
@@ -301,6 +306,7 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
   ao.independentFrames = a.independentFrames;
   ao.sharedScale = a.sharedPhotons.value_or(ao.sharedScale);
   ao.movingScale = a.movingPhotons.value_or(ao.movingScale);
+  if (a.continuePaths || a.noContinuePaths) ao.continuePaths = a.continuePaths;
   std::vector<FrameLine> lines;
   uint64_t peakRss = 0;
   Timer frameTimer;

@@ -80,6 +80,7 @@ std::map<std::string, std::string> rankSettings(const RenderArgs& a, const scene
     s["independent_frames"] = a.independentFrames ? "yes" : "no";
     s["shared_photons"] = a.sharedPhotons ? exact(*a.sharedPhotons) : "default";
     s["moving_photons"] = a.movingPhotons ? exact(*a.movingPhotons) : "default";
+    s["continue_paths"] = a.continuePaths ? "yes" : a.noContinuePaths ? "no" : "default";
     s["output"] = a.output;
   }
   return s;

@@ -459,6 +459,13 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   c->add_option("--moving-photons", a.movingPhotons, "With --shared-photons: each frame traces this many times its "
                 "paths for the photons whose path meets motion (default " + shortNumber(AnimationOptions{}.movingScale) + ")")
       ->check(CLI::Range(0.001, 1000.0))->group(animationGroup);
+  CLI::Option* cont = c->add_flag("--continue-paths", a.continuePaths,
+              "With --shared-photons: each frame continues the block's photon paths that meet motion from their "
+              "last time-invariant vertex instead of tracing its paths from the light (default: " +
+                  std::string(AnimationOptions{}.continuePaths ? "on" : "off") + "; docs/animation.md section 8)")
+      ->group(animationGroup);
+  c->add_flag("--no-continue-paths", a.noContinuePaths, "With --shared-photons: every frame traces its paths from the light")
+      ->excludes(cont)->group(animationGroup);
   addProgressiveOptions(c, a);
   return c;
 }
@@ -584,13 +591,16 @@ ProgressiveState startProgressiveState(const RenderArgs& a, const RenderSetup& s
 
 // The animation flags on a scene without an animation block.
 void refuseAnimationFlags(const RenderArgs& a, bool framePattern) {
-  if (framePattern || a.frameRange || a.video || a.window || a.independentFrames || a.sharedPhotons || a.movingPhotons)
+  if (framePattern || a.frameRange || a.video || a.window || a.independentFrames || a.sharedPhotons || a.movingPhotons ||
+      a.continuePaths || a.noContinuePaths)
     throw Error(std::string(framePattern ? "--output: a frame-number pattern (#)"
                             : a.frameRange ? "--frame-range"
                             : a.video      ? "--video"
                             : a.window     ? "--window"
                             : a.sharedPhotons ? "--shared-photons"
                             : a.movingPhotons ? "--moving-photons"
+                            : a.continuePaths ? "--continue-paths"
+                            : a.noContinuePaths ? "--no-continue-paths"
                                            : "--independent-frames") +
                 " needs an animation, but " + a.scene + " has no \"animation\" block (docs/scene-format.md)");
 }

@@ -40,6 +40,7 @@ struct RenderArgs {
   std::optional<int> window;
   bool independentFrames = false;
   std::optional<double> sharedPhotons, movingPhotons;  // --shared-photons, --moving-photons
+  bool continuePaths = false, noContinuePaths = false;  // --continue-paths / --no-continue-paths
   // progressive passes (cli/progressive_options.h)
   bool progressive = false;
   bool fixedBudget = false;  // --fixed-budget: overrides render.progressive of the scene

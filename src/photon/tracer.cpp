@@ -26,7 +26,6 @@ namespace tdpm::photon {
 
 namespace {
 
-constexpr uint32_t kPilotBatches = 16;
 // Photon bounces whose Sobol group seeds are hashed once per batch (deeper
 // bounces hash theirs per draw, as the eye paths do): groups up to the
 // roulette slot of vertex kSeedTableBounces.
@@ -431,7 +430,8 @@ struct Tracer {
   // Traces paths [first, first + count) of batch `b` into `out`, energies
   // scaled by `energyScale` (= ts / n_e). Returns nothing: out grows.
   // Returns the number of rays cast.
-  uint64_t traceBatch(uint64_t local, double energyScale, PhotonStore& out, std::vector<ExitPoint>* exits) const {
+  uint64_t traceBatch(uint64_t local, double energyScale, PhotonStore& out, std::vector<ExitPoint>* exits,
+                      std::vector<PathState>* kept = nullptr) const {
     uint64_t b = batchOffset + local;
     Rng rng(hashCombine(settings.seed, uint64_t(settings.kind) + 1, b), 0x9e37);
     // sobol: the path index is the sample index, the map's seed and kind the "pixel".
@@ -462,10 +462,10 @@ struct Tracer {
         SobolStream s{sobolSeed, uint32_t(g)};
         s.table = seedTable.data();
         s.tableSize = kSeedTableGroups;
-        rays += tracePath(time01, g, s, energyScale, out, exits);
+        rays += tracePath(time01, g, s, energyScale, out, exits, kept);
       } else {
         RandomStream s{&rng};
-        rays += tracePath(time01, g, s, energyScale, out, exits);
+        rays += tracePath(time01, g, s, energyScale, out, exits, kept);
       }
     }
     return rays;
@@ -475,9 +475,11 @@ struct Tracer {
   // the group and draws in call order, which is the old PCG32 order.
   // exits (caustic maps, optional): receives each stored photon's last
   // specular vertex, in store order.
+  // kept (InvariantPhotons::Only with keepMoving): receives the state of
+  // every path that meets motion, before the segment that does.
   template <class Stream>
   uint64_t tracePath(float time01, uint64_t pathIndex, Stream& rng, double energyScale, PhotonStore& out,
-                     std::vector<ExitPoint>* exits) const {
+                     std::vector<ExitPoint>* exits, std::vector<PathState>* kept = nullptr) const {
     uint64_t rays = 0;
     uint32_t li = lights.pick(rng.get1D(dims::kPhotonLight));
     const Light& light = scene.lights[li];
@@ -492,7 +494,17 @@ struct Tracer {
     // Time-invariant so far (settings.invariant != All): a still light, and
     // every segment up to here misses what moves over the window.
     bool invariant = settings.invariant != InvariantPhotons::All && !light.motion.moving();
-    if (settings.invariant == InvariantPhotons::Only && !invariant) return rays;
+    if (settings.invariant == InvariantPhotons::Only && !invariant) {
+      if (kept) {  // a moving light: the continuation emits again at its own time
+        PathState st;
+        st.power = Rgb(1.0f / lights.pdf[li]);
+        st.pathIndex = pathIndex;
+        st.light = li;
+        st.fromLight = true;
+        kept->push_back(st);
+      }
+      return rays;
+    }
     Rgb power = ray.flux / lights.pdf[li];
     float time = scene.shutter.instant() ? t0 : scene.shutter.fromNormalized(time01);
     // Off the emitter's surface: an area light is geometry, and a photon
@@ -509,15 +521,41 @@ struct Tracer {
       MediaPath mp{origin, dir, power, time01, time, scene.lightMedia[li], invariant, pathIndex};
       return rays + walkPhotonInMedia(scene, settings, mp, rng, energyScale, out, exits);
     }
-    bool allSpecular = true;  // every bounce so far was a delta reflection/refraction
+    return rays + bounces(0, origin, dir, power, true, invariant, time01, time, li, pathIndex, rng, energyScale, out,
+                          exits, kept);
+  }
+
+  // The path's vertices from `first` on (the loop's count of segments so
+  // far), its ray (origin, dir) and power: the rest of tracePath, and the
+  // whole of a continuation (continuePaths), which starts where a block
+  // pass kept the path.
+  template <class Stream>
+  uint64_t bounces(int first, Vec3f origin, Vec3f dir, Rgb power, bool allSpecular, bool invariant, float time01,
+                   float time, uint32_t li, uint64_t pathIndex, Stream& rng, double energyScale, PhotonStore& out,
+                   std::vector<ExitPoint>* exits, std::vector<PathState>* kept) const {
+    uint64_t rays = 0;
+    // allSpecular: every bounce so far was a delta reflection/refraction
     Vec3f lastSpecular = origin;
-    for (int bounce = 0; bounce <= settings.maxBounces; ++bounce) {
+    for (int bounce = first; bounce <= settings.maxBounces; ++bounce) {
       Hit hit;
       ++rays;
       if (!scene.intersect(origin, dir, std::numeric_limits<float>::infinity(), time01, hit)) return rays;
       if (invariant && settings.motion->meets(origin, dir, hit.t)) {
         invariant = false;
-        if (settings.invariant == InvariantPhotons::Only) return rays;  // nothing further is invariant
+        if (settings.invariant == InvariantPhotons::Only) {  // nothing further is invariant
+          if (kept) {
+            PathState st;
+            st.origin = origin;
+            st.dir = dir;
+            st.power = power;
+            st.pathIndex = pathIndex;
+            st.light = li;
+            st.bounce = uint16_t(bounce);
+            st.allSpecular = allSpecular;
+            kept->push_back(st);
+          }
+          return rays;
+        }
       }
       if (hit.isLight()) return rays;  // emitters absorb
       Rgb mixWeight(1.0f);  // a per-channel mix's weight (Scene::materialAt)
@@ -564,7 +602,7 @@ struct Tracer {
   // per photon instead of holding every batch buffer and the result at once.
   PhotonStore traceBatches(uint64_t firstBatch, uint64_t endBatch, double energyScale, const Progress& progress,
                            const char* stage, size_t expected, uint64_t* raysOut = nullptr,
-                           std::vector<ExitPoint>* exitsOut = nullptr) const {
+                           std::vector<ExitPoint>* exitsOut = nullptr, std::vector<PathState>* keptOut = nullptr) const {
     PhotonStore all(t0, t1);
     all.reserve(expected);
     std::atomic<uint64_t> rays{0};
@@ -575,18 +613,30 @@ struct Tracer {
     progress(stage, 0, paths);
     std::vector<PhotonStore> parts;
     std::vector<std::vector<ExitPoint>> partExits;
+    std::vector<std::vector<PathState>> partKept;
     for (uint64_t first = firstBatch; first < endBatch; first += kBatchesPerChunk) {
       size_t count = size_t(std::min<uint64_t>(kBatchesPerChunk, endBatch - first));
       parts.assign(count, PhotonStore(t0, t1));
       partExits.assign(exitsOut ? count : 0, {});
+      partKept.assign(keptOut ? count : 0, {});
       tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t b = r.begin(); b != r.end(); ++b) {
-          rays += traceBatch(first + b, energyScale, parts[b], exitsOut ? &partExits[b] : nullptr);
+          rays += traceBatch(first + b, energyScale, parts[b], exitsOut ? &partExits[b] : nullptr,
+                             keptOut ? &partKept[b] : nullptr);
           progress(stage, (done.fetch_add(1) + 1) * kPathsPerBatch, paths);
         }
       });
       all.appendBatches(parts);
       for (const std::vector<ExitPoint>& e : partExits) exitsOut->insert(exitsOut->end(), e.begin(), e.end());
+      if (keptOut) {  // grown once per chunk, to its size: no doubling slack on top of the parts
+        size_t n = keptOut->size();
+        for (const std::vector<PathState>& k : partKept) n += k.size();
+        keptOut->reserve(n);
+        for (std::vector<PathState>& k : partKept) {
+          keptOut->insert(keptOut->end(), k.begin(), k.end());
+          std::vector<PathState>().swap(k);
+        }
+      }
     }
     if (raysOut) *raysOut = rays.load();
     return all;
@@ -763,6 +813,9 @@ TraceResult traceMap(const Scene& scene, const TraceSettings& settings, const Tr
                 t1, ts,
                 uint32_t(mix64(settings.seed ^ 0x7173ull)), u0, u1};
   TDPM_ASSERT(settings.invariant == InvariantPhotons::All || settings.motion, "time-invariance needs the motion bounds");
+  TDPM_ASSERT(!settings.keepMoving || (settings.invariant == InvariantPhotons::Only && !settings.comm->distributed() &&
+                                       !scene.hasMedia() && extras.range.paths == 0),
+              "kept path states: a block pass of one process, without media");
   if (settings.storedWanted == 0 || tracer.lights.empty()) return result;
   if (settings.kind == MapKind::Caustic && !sceneHasSpecular(scene, settings.glossyCaustics)) return result;
   if (settings.kind == MapKind::Volume && !scene.hasMedia()) return result;  // nowhere to scatter
@@ -792,7 +845,7 @@ TraceResult traceMap(const Scene& scene, const TraceSettings& settings, const Tr
   // Distributed, every rank traces its block of each round and the counts
   // are summed (integers), so every rank takes the same decisions.
   dist::Comm& comm = *settings.comm;
-  uint64_t pilotBatches = kPilotBatches;
+  uint64_t pilotBatches = std::max<uint32_t>(1, settings.pilotBatches);
   size_t stored = 0;
   uint64_t pilotRays = 0;
   for (;;) {
@@ -847,7 +900,13 @@ TraceResult traceMap(const Scene& scene, const TraceSettings& settings, const Tr
     comm.allreduceSum(&result.rays, 1);
   } else {
     result.store = tracer.traceBatches(0, batches, energyScale, progress, stage, expected, &result.rays,
-                                       extras.guide ? &result.exitPoints : nullptr);
+                                       extras.guide ? &result.exitPoints : nullptr,
+                                       settings.keepMoving ? &result.kept.states : nullptr);
+  }
+  if (settings.keepMoving) {
+    result.kept.states.shrink_to_fit();  // held for the block: not the growth's slack
+    result.kept.emitted = result.emitted;
+    result.kept.sobolSeed = hashCombine(settings.seed, uint64_t(settings.kind) + 1, 0x9407ull);
   }
   result.rays += pilotRays;
   result.store.shrinkToFit();
@@ -874,6 +933,128 @@ TraceResult traceSegmentPhotons(const Scene& scene, const TraceSettings& setting
   x.segment = true;
   x.store = segment;
   return traceMap(scene, settings, x, progress);
+}
+
+namespace {
+
+// One continued path of a segment: a kept state, its virtual index j in the
+// segment (its time and, with the random sampler, its numbers) and its
+// round (how many times the block's paths were gone through before it).
+struct ContinuedPath {
+  uint32_t state;
+  uint32_t round;
+  uint64_t j;
+};
+constexpr size_t kContinuedPerBatch = 256;
+
+}  // namespace
+
+TraceResult continuePaths(const Scene& scene, const TraceSettings& settings, const KeptPaths& kept,
+                          const Continuation& c, const Progress& progress) {
+  Timer timer;
+  TraceResult result;
+  TDPM_ASSERT(!scene.hasMedia() && std::isfinite(settings.timeOpen) && settings.timeClose > settings.timeOpen,
+              "continued photon paths: a segment's times, no media");
+  const float u0 = scene.shutter.normalized(settings.timeOpen), u1 = scene.shutter.normalized(settings.timeClose);
+  result.store = PhotonStore(c.storeT0, c.storeT1);
+  result.emitted = c.virtualPaths;
+  const uint64_t n = kept.emitted;
+  if (c.virtualPaths == 0 || n == 0 || kept.states.empty()) return result;
+  // The kept states whose block path some virtual path j takes, in j order
+  // within each pass over the block's paths (states are in path order).
+  std::vector<ContinuedPath> work;
+  work.reserve(std::min<uint64_t>(kept.states.size(), c.virtualPaths));
+  for (uint64_t v = c.firstVirtual, end = c.firstVirtual + c.virtualPaths; v < end;) {
+    const uint64_t round = v / n, a = v % n, b = std::min(n, a + (end - v));
+    auto byIndex = [](const PathState& st, uint64_t i) { return st.pathIndex < i; };
+    auto lo = std::lower_bound(kept.states.begin(), kept.states.end(), a, byIndex);
+    auto hi = std::lower_bound(lo, kept.states.end(), b, byIndex);
+    for (auto it = lo; it != hi; ++it)
+      work.push_back({uint32_t(it - kept.states.begin()), uint32_t(round), round * n + it->pathIndex - c.firstVirtual});
+    v += b - a;
+  }
+  result.continued = work.size();
+  std::vector<Target> targets;
+  if (settings.kind == MapKind::Caustic) targets = specularTargets(scene, settings.glossyCaustics, u0, u1);
+  // The light table is not drawn from (a state keeps its light and the
+  // block's choice probability); the tracer needs one.
+  Tracer tracer{scene, settings, targets,
+                makeLightTable(scene, settings.kind == MapKind::Caustic && settings.projection ? &targets : nullptr, false),
+                c.storeT0, c.storeT1, settings.timeClose - settings.timeOpen,
+                uint32_t(mix64(settings.seed ^ 0x7173ull)), u0, u1};
+  // Q = power x ts / (the segment's virtual paths): path j stands for one
+  // of them, as the paths of a full trace of the segment do.
+  const double energyScale = double(tracer.ts) / double(c.virtualPaths);
+  const size_t batches = (work.size() + kContinuedPerBatch - 1) / kContinuedPerBatch;
+  std::vector<PhotonStore> parts(batches, PhotonStore(c.storeT0, c.storeT1));
+  std::atomic<uint64_t> rays{0};
+  progress("continued photons", 0, work.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, batches, 1), [&](const tbb::blocked_range<size_t>& r) {
+    std::array<SobolStream::GroupSeeds, kSeedTableGroups> seedTable;
+    uint64_t tableSeed = 0;
+    bool tableFilled = false;
+    for (size_t bi = r.begin(); bi != r.end(); ++bi) {
+      uint64_t here = 0;
+      for (size_t w = bi * kContinuedPerBatch; w < std::min(work.size(), (bi + 1) * kContinuedPerBatch); ++w) {
+        const ContinuedPath& cp = work[w];
+        const PathState& st = kept.states[cp.state];
+        const float time01 = u0 + scrambledVanDerCorput(uint32_t(cp.j), tracer.timeScramble) * (u1 - u0);
+        const float time = scene.shutter.fromNormalized(time01);
+        auto run = [&](auto& rng) -> uint64_t {
+          Vec3f origin = st.origin, dir = st.dir;
+          Rgb power = st.power;
+          if (st.fromLight) {  // a moving light: emitted at the continuation's time
+            const Light& light = scene.lights[st.light];
+            EmittedRay ray;
+            if (settings.kind == MapKind::Caustic && settings.projection) {
+              if (!emitTowardTargets(light, tracer.targets, time01, scene.bounds, rng, ray)) return 0;
+            } else {
+              Vec2f uPos = rng.get2D(dims::kPhotonPosition);
+              Vec2f uDir = rng.get2D(dims::kPhotonDirection);
+              if (!emitFromLight(light, time01, scene.bounds, uPos, uDir, ray)) return 0;
+            }
+            power = ray.flux * st.power;
+            origin = scene.spawnOrigin(ray.origin, ray.direction, ray.direction);
+            dir = ray.direction;
+          }
+          return tracer.bounces(st.bounce, origin, dir, power, st.allSpecular, false, time01, time, st.light,
+                                st.pathIndex, rng, energyScale, parts[bi], nullptr, nullptr);
+        };
+        if (settings.sampler == SamplerKind::Sobol) {
+          // Round 0 of a frame drawing what every frame draws: the block
+          // path's own sequence (its later dimensions, which the block pass
+          // did not use); otherwise a sequence of its own.
+          uint64_t seed = cp.round == 0 && c.streamKey == 0 ? kept.sobolSeed
+                                                            : hashCombine(kept.sobolSeed, c.streamKey, cp.round);
+          if (uint64_t high = st.pathIndex >> 32) seed = hashCombine(seed, high);
+          if (!tableFilled || seed != tableSeed) {
+            SobolStream::fillSeedTable(seed, seedTable.data(), kSeedTableGroups);
+            tableSeed = seed;
+            tableFilled = true;
+          }
+          SobolStream s{seed, uint32_t(st.pathIndex)};
+          s.table = seedTable.data();
+          s.tableSize = kSeedTableGroups;
+          here += run(s);
+        } else {
+          Rng rng(hashCombine(settings.seed, uint64_t(settings.kind) + 1, cp.j), 0xc047);
+          RandomStream s{&rng};
+          here += run(s);
+        }
+      }
+      rays += here;
+    }
+  });
+  result.store.reserve([&] {
+    size_t t = 0;
+    for (const PhotonStore& p : parts) t += p.size();
+    return t;
+  }());
+  result.store.appendBatches(parts);
+  progress("continued photons", work.size(), work.size());
+  result.rays = rays.load();
+  result.seconds = timer.seconds();
+  return result;
 }
 
 TraceResult traceGuidePhotons(const Scene& scene, const TraceSettings& settings, const Progress& progress) {

@@ -90,6 +90,50 @@ struct TraceSettings {
   // All: the kept photons are exactly those All would store of their kind.
   InvariantPhotons invariant = InvariantPhotons::All;
   const MotionBounds* motion = nullptr;
+  // With InvariantPhotons::Only: keep, for every path that meets motion, its
+  // state before the first segment that does (TraceResult::kept), so that
+  // frames can continue it at their own times (continuePaths).
+  bool keepMoving = false;
+  // The pilot's first round, in batches (it grows 8x a round while nothing
+  // is stored): the stored photons per path it measures size the emission.
+  uint32_t pilotBatches = 16;
+};
+
+// A path of a block's pass (InvariantPhotons::Only, keepMoving) at its last
+// time-invariant vertex: everything before the segment that first meets
+// the motion bounds, which is the same at every instant of the block
+// (docs/animation.md section 8). `power` is the flux over the densities so
+// far (no energy scale); a path from a moving light has no invariant part
+// and keeps only its light (fromLight: power = 1 / the light's choice
+// probability, the emission redone at the continuation's time).
+struct PathState {
+  Vec3f origin, dir;     // the ray of the segment that meets motion (origin spawned off its surface)
+  Rgb power;
+  uint64_t pathIndex = 0;  // the block path's global index (Sobol sample index)
+  uint32_t light = 0;
+  uint16_t bounce = 0;     // the loop's vertex count at that segment
+  bool allSpecular = true;
+  bool fromLight = false;
+};
+
+// A block pass's kept states (in path order) and what a continuation needs
+// to draw the rest of their numbers as the block pass would have.
+struct KeptPaths {
+  std::vector<PathState> states;  // sorted by pathIndex
+  uint64_t emitted = 0;           // N: the block pass's paths
+  uint64_t sobolSeed = 0;         // its paths' Sobol "pixel" seed
+};
+
+// A frame segment's continuation (continuePaths): `virtualPaths` paths
+// over the segment's time, path j taking block path (firstVirtual + j) mod
+// N; those that met motion are continued from their state at time j's
+// stratified time, the others carry invariant light, which the block's
+// shared set holds. Round r = (firstVirtual + j) / N > 0 reuses a block
+// path with fresh numbers (Sobol seed hashed with r and streamKey).
+struct Continuation {
+  float storeT0 = 0, storeT1 = 1;
+  uint64_t firstVirtual = 0, virtualPaths = 0;
+  uint64_t streamKey = 0;  // 0: a frame draws what every frame draws (common random numbers)
 };
 
 // What one caller alone adds to a trace: each has its own entry point below.
@@ -132,6 +176,8 @@ struct TraceResult {
   std::string warning;   // set when the map is empty or smaller than wanted
   double storedPerPath = 0;  // the pilot's rate (or the one given), 0 when nothing is stored
   std::vector<ExitPoint> exitPoints;  // traceGuidePhotons: photon i's, in store order
+  KeptPaths kept;                     // TraceSettings::keepMoving
+  uint64_t continued = 0;             // continuePaths: states continued
 };
 
 // Shutter interval the photon store quantises time over. A zero-length
@@ -149,6 +195,13 @@ TraceResult tracePassPhotons(const Scene& scene, const TraceSettings& settings, 
 // An animation segment's paths (SegmentStore).
 TraceResult traceSegmentPhotons(const Scene& scene, const TraceSettings& settings, const SegmentStore& segment,
                                 const Progress& progress);
+// A segment's photons of the paths that meet motion, continued from a
+// block pass's states (settings: the segment's times and seed, the kind,
+// sampler and bounces of the block pass; InvariantPhotons is not used:
+// every photon after the state is kept). Energies Q = power x (timeClose -
+// timeOpen) / virtualPaths. Scenes without media only.
+TraceResult continuePaths(const Scene& scene, const TraceSettings& settings, const KeptPaths& kept,
+                          const Continuation& continuation, const Progress& progress);
 // The path tracer's caustic guide (render/caustic_guide.h): emitted from
 // area lights only (point, spot and sun caustics are not paths a path
 // tracer can find), each stored photon's last specular vertex kept in

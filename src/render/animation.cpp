@@ -63,6 +63,14 @@ struct SharedSet {
   int64_t lo = 0, hi = 0;
   photon::MotionBounds motion;  // swept bounds of what moves during [lo, hi)
   PerMap<photon::PhotonStore> stores;
+  // Continuation: the block pass's paths that met motion, at their last
+  // invariant vertex (a flat array per kind, freed with the block).
+  PerMap<photon::KeptPaths> kept;
+  size_t keptStates() const {
+    size_t n = 0;
+    for (MapKind k : kAllMapKinds) n += kept[k].states.size();
+    return n;
+  }
   size_t size() const {
     size_t n = 0;
     for (MapKind k : kAllMapKinds) n += stores[k].size();
@@ -329,6 +337,7 @@ class SegmentTimeline {
       ts.timeClose = t1;
       ts.invariant = photon::InvariantPhotons::Only;
       ts.motion = &shared_.motion;
+      ts.keepMoving = continuing();
       photon::SegmentStore grid;
       grid.storeT0 = t0;
       grid.storeT1 = t1;
@@ -337,7 +346,9 @@ class SegmentTimeline {
       countTrace(kind, r);
       stats_.sharedPhotons += r.store.size();
       shared_.stores[kind] = std::move(r.store);
+      shared_.kept[kind] = std::move(r.kept);
     }
+    stats_.peakKeptStates = std::max(stats_.peakKeptStates, shared_.keptStates());
     ++stats_.sharedSets;
     stats_.sharedSeconds += timer.seconds();
   }
@@ -356,6 +367,10 @@ class SegmentTimeline {
   uint64_t emitted() const { return emitted_; }
 
  private:
+  // Frames continue the block's paths that meet motion (section 8) rather
+  // than trace theirs from the light: not in media (the walk of
+  // photon/tracer_media.h keeps no states).
+  bool continuing() const { return ao_.continuePaths && ao_.sharedScale > 0 && !scene_.hasMedia(); }
   // What every trace of a map adds to the totals (shared sets and segments).
   void countTrace(MapKind kind, const photon::TraceResult& r) {
     addWarning(stats_, r.warning);
@@ -381,6 +396,12 @@ class SegmentTimeline {
   // over bins [lo, hi).
   double pilotRate(int64_t lo, int64_t hi, MapKind kind, uint64_t seed) {
     photon::TraceSettings ts = traceSettingsFor(opt_, kind, 1, seed);
+    // Continuing (section 8): the block's pilot is most of what is left of
+    // the frames' photon cost besides the shared set (16 batches per kind
+    // against a global set of 3 in still-room); 4 batches measure the rate
+    // to a few percent, which only sizes the counts (energies use the
+    // emitted paths).
+    if (continuing()) ts.pilotBatches = 4;
     ts.timeOpen = float(double(lo) * grid_.binWidth);
     ts.timeClose = float(double(hi) * grid_.binWidth);
     photon::TraceResult r = photon::tracePhotons(scene_, ts, Progress{});
@@ -421,11 +442,16 @@ class SegmentTimeline {
         ts.invariant = photon::InvariantPhotons::None;
         ts.motion = &shared_.motion;
       }
-      photon::SegmentStore grid;  // the timeline's bins, and the period's measured rate
-      grid.storeT0 = ts.timeOpen;
-      grid.storeT1 = float(double(lo + photon::kTimeBins) * grid_.binWidth);
-      grid.storedPerPath = rate;
-      photon::TraceResult r = photon::traceSegmentPhotons(scene_, ts, grid, framed_);
+      photon::TraceResult r;
+      if (shared_.block >= 0 && continuing()) {
+        r = continueSegment(lo, kind, ts, rate, period, key);
+      } else {
+        photon::SegmentStore grid;  // the timeline's bins, and the period's measured rate
+        grid.storeT0 = ts.timeOpen;
+        grid.storeT1 = float(double(lo + photon::kTimeBins) * grid_.binWidth);
+        grid.storedPerPath = rate;
+        r = photon::traceSegmentPhotons(scene_, ts, grid, framed_);
+      }
       countTrace(kind, r);
       stats_.segmentPaths += r.emitted;
       stats_.segmentPhotons += r.store.size();
@@ -436,6 +462,33 @@ class SegmentTimeline {
       seg.stores[kind] = std::move(r.store);
     }
     return seg;
+  }
+
+  // A segment's photons of the paths that meet motion, continued from the
+  // block's kept states (section 8): as many virtual paths as the full
+  // trace would emit (the same paths per second; a path that did not meet
+  // motion stands for its invariant light, which the shared set holds), the
+  // segment's virtual paths taking the block's paths at the segment's place
+  // in its frame's map, so a frame's segments take disjoint block paths
+  // when it has no more than the block pass (movingScale <= sharedScale),
+  // and every frame takes the same ones at the same phase (common random
+  // numbers; --independent-frames: fresh numbers per segment).
+  photon::TraceResult continueSegment(int64_t lo, MapKind kind, const photon::TraceSettings& ts,
+                                      double rate, int64_t period, uint64_t key) {
+    const photon::KeptPaths& kept = shared_.kept[kind];
+    const double wanted = double(ts.storedWanted);
+    const double paths = std::min(wanted / rate, photon::kMaxPathsPerPhoton * wanted);
+    photon::Continuation c;
+    c.storeT0 = ts.timeOpen;
+    c.storeT1 = float(double(lo + photon::kTimeBins) * grid_.binWidth);
+    c.virtualPaths = uint64_t(std::max(1.0, std::ceil(paths)));
+    const int64_t mapBins = grid_.shutterBins + 2 * grid_.padBins;
+    const int64_t at = std::clamp<int64_t>(lo - grid_.mapLo(int(period)), 0, mapBins);
+    c.firstVirtual = uint64_t(double(kept.emitted) * double(at) / double(mapBins));
+    c.streamKey = ao_.independentFrames ? key : 0;
+    photon::TraceResult r = photon::continuePaths(scene_, ts, kept, c, framed_);
+    stats_.continuedPaths += r.continued;
+    return r;
   }
 
   const Scene& scene_;

@@ -59,6 +59,12 @@ struct AnimationOptions {
   // sharedScale 0: no sharing (every frame traces all its photons).
   double sharedScale = 1.0;
   double movingScale = 0.5;  // measured default: docs/animation.md "Defaults and what they buy"
+  // With sharing: the frames' photons whose path meets motion are continued
+  // from the block pass's paths at their last time-invariant vertex
+  // instead of traced from the light (docs/animation.md section 8). Scenes
+  // with media always trace from the light. Measured default:
+  // docs/animation.md section 8.
+  bool continuePaths = true;
 };
 
 struct AnimationStats {
@@ -74,6 +80,10 @@ struct AnimationStats {
   // of the pads (segments outside every shutter: the time kernel's reach).
   uint64_t segmentPaths = 0, padPaths = 0;
   size_t segmentPhotons = 0, padPhotons = 0;
+  // Continuation: the block passes' kept path states (the most held at
+  // once, all kinds) and the frames' continued paths (of segmentPaths).
+  size_t peakKeptStates = 0;
+  uint64_t continuedPaths = 0;
   uint64_t passesDone = 0;                    // --progressive: passes of all frames (no segments are traced)
   size_t peakHeldPhotons = 0;                 // segments + the frame's maps, at most
   std::vector<std::string> warnings;
