@@ -58,6 +58,13 @@ struct RenderOptions {
   // kDefaultVolumePhotons; --volume-photons, render.volume_photons).
   size_t volumePhotons = 0;
   static constexpr size_t kDefaultVolumePhotons = 100000;
+  // k of the volume photons' beam kernels (photon/volume_beam_map.h): the
+  // disc radius is the distance to the k-th nearest volume photon. A
+  // segment of length L crosses about (3/4) k L / r discs, so the query's
+  // cost grows as k^(2/3); the surface estimates' k (100) made ~1,300
+  // crossings a camera ray in thin fog (docs/media.md, "The beam query's
+  // cost"). --volume-k.
+  int volumeK = 32;
   int frames = 8;                  // accumulation: in-between frames
   bool spaceTime4D = false;        // --search 4d
   float kappa = 1.0f;              // 4D metric weight
