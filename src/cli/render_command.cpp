@@ -412,7 +412,8 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
       ->check(rangeOf(limits::kK))->group(photonGroup);
   c->add_option("--volume-k", a.volumeK,
                 "Scenes with media: each volume photon's beam disc is its distance to its k-th nearest volume photon, "
-                "and its time window the fraction --fraction nearest in time of those k (default 32; docs/media.md, "
+                "and its time window the fraction --fraction nearest in time of those k (default 32 with a fixed budget, "
+                "--k with --progressive; docs/media.md, "
                 "\"The beam query's cost\")")
       ->check(rangeOf(limits::kVolumeK))->group(photonGroup);
   c->add_option("--fraction", a.fraction, "twopass: fraction of the k_s kept nearest in time (default 0.5)")
