@@ -273,6 +273,7 @@ RenderOptions mergeOptions(const RenderArgs& a, const scene::RenderSettings& sc,
   o.spaceTime4D = pick(a.search, sc.search, std::string("twopass")) == "4d";
   o.estimate.k = pick(a.k, sc.k, o.estimate.k);
   o.estimate.ks = o.estimate.k;  // the two-pass search takes k in space, keeps f*k in time
+  o.volumeK = a.volumeK.value_or(o.volumeK);
   o.estimate.fraction = pick(a.fraction, sc.fraction, o.estimate.fraction);
   o.kappa = pick(a.kappa, sc.kappa, o.kappa);
   if (a.maxRadius || sc.maxRadius) o.estimate.maxRadius = pick(a.maxRadius, sc.maxRadius, 0.0f);
@@ -409,6 +410,12 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
       ->check(CLI::IsMember({"twopass", "4d"}))->group(photonGroup);
   c->add_option("--k", a.k, "Photons in the spatial search: k for standard and 4d, k_s for twopass (default 100)")
       ->check(rangeOf(limits::kK))->group(photonGroup);
+  c->add_option("--volume-k", a.volumeK,
+                "Scenes with media: each volume photon's beam disc is its distance to its k-th nearest volume photon, "
+                "and its time window the fraction --fraction nearest in time of those k (default 32 with a fixed budget, "
+                "--k with --progressive; docs/media.md, "
+                "\"The beam query's cost\")")
+      ->check(rangeOf(limits::kVolumeK))->group(photonGroup);
   c->add_option("--fraction", a.fraction, "twopass: fraction of the k_s kept nearest in time (default 0.5)")
       ->check(rangeOf(limits::kFraction))->group(photonGroup);
   c->add_option("--kappa", a.kappa, "4d: weight of time in the metric d^2 = |dx|^2 + kappa dt^2 (default 1; for a 1 s shutter at least 7.704e-34 and at most 8.507e37, see docs/scene-format.md)")

@@ -26,7 +26,7 @@ struct RenderArgs {
   std::optional<float> exposure;
   // photon methods
   std::optional<int64_t> photons, globalPhotons, volumePhotons;
-  std::optional<int> frames, k, gather;
+  std::optional<int> frames, k, gather, volumeK;
   std::optional<std::string> search, kernelSpace, kernelTime;
   std::optional<std::string> sampler, filter;
   std::optional<float> filterRadius;

@@ -43,9 +43,13 @@
 //
 // Queries: crossing() walks the tree depth-first with an explicit stack of
 // (node, cell) on a per-thread BeamQuery (no allocation, no virtual call per
-// node): a node is entered if the segment meets its cell grown by the
-// subtree bound (a slab test), and each photon is tested exactly (distance
-// from the line < r_i, projection in [s0, s1]). The visitor, a template
+// node): a child is entered if the segment meets its cell grown by its
+// subtree bound (a slab test, made before it is pushed; the first child
+// entered goes on without a push), and each photon is tested exactly
+// (distance from the line < r_i, projection in [s0, s1]). The children of
+// the last inner level are leaves: their photons are tested at once with no
+// box test (measured on fog-glass-ball, docs/media.md "The beam query's
+// cost": leaves were half the nodes walked). The visitor, a template
 // parameter, is inlined.
 #pragma once
 #include <cmath>
@@ -166,40 +170,71 @@ void VolumeBeamMap::crossing(const Segment& seg, BeamQuery& q, Visit&& visit) co
   const float* pz = s.zs();
   const uint16_t* flags = s.flags();
   const float inv[3] = {1.0f / seg.d.x, 1.0f / seg.d.y, 1.0f / seg.d.z};
-  auto* stack = q.stack_.data();
-  int top = 0;
-  stack[0].node = 0;
-  for (int k = 0; k < 3; ++k) stack[0].lo[k] = lo_[k], stack[0].hi[k] = hi_[k];
-  ++top;
-  while (top > 0) {
-    const auto e = stack[--top];
-    const uint32_t i = e.node;
-    if (!segmentMeetsBox(seg, inv, e.lo, e.hi, radiusOf_[bound_[i]])) continue;
-    // The photon at this node.
+  // The exact test of photon i's disc.
+  auto test = [&](uint32_t i) {
     const float vx = px[i] - seg.o.x, vy = py[i] - seg.o.y, vz = pz[i] - seg.o.z;
     const float sp = vx * seg.d.x + vy * seg.d.y + vz * seg.d.z;
     const float cx = vy * seg.d.z - vz * seg.d.y, cy = vz * seg.d.x - vx * seg.d.z, cz = vx * seg.d.y - vy * seg.d.x;
     const float d2 = cx * cx + cy * cy + cz * cz;
     if (d2 < radius2Of_[radiusCode_[i]] && sp >= seg.s0 && sp <= seg.s1) visit(i, sp, d2);
-    // Its children: left holds <= split, right >= split on the node's axis.
+  };
+  // Nodes from here on have only leaves below them (a left-balanced heap:
+  // if the left child is a leaf, so is the right one).
+  const uint32_t lastInner = n / 2;  // nodes i < n/2 have a child
+  auto* stack = q.stack_.data();
+  int top = 0;
+  BeamQuery::Entry e;
+  e.node = 0;
+  for (int k = 0; k < 3; ++k) e.lo[k] = lo_[k], e.hi[k] = hi_[k];
+  if (!segmentMeetsBox(seg, inv, e.lo, e.hi, radiusOf_[bound_[0]])) return;
+  // Every entry on the stack (and e) has passed its box test.
+  for (;;) {
+    const uint32_t i = e.node;
+    test(i);
     const uint32_t left = 2 * i + 1;
-    if (left >= n) continue;
-    const int axis = (flags[i] & kAxisMask) >> kAxisShift;
-    const float split = axis == 0 ? px[i] : (axis == 1 ? py[i] : pz[i]);
-    if (top + 2 > int(q.stack_.size())) {  // cannot happen for a balanced tree; stay safe
-      q.stack_.resize(q.stack_.size() * 2);
-      stack = q.stack_.data();
+    if (left < n) {
+      if (left >= lastInner) {
+        // Both children are leaves: their discs' exact tests replace the
+        // box tests (a leaf prunes nothing below it). Half the nodes are
+        // leaves, and this is where most of the walk's time went.
+        test(left);
+        if (left + 1 < n) test(left + 1);
+      } else {
+        // Its children: left holds <= split, right >= split on the node's
+        // axis; each is entered only if the segment meets its cell grown by
+        // its subtree's largest radius; the one entered first goes on in e.
+        const int axis = (flags[i] & kAxisMask) >> kAxisShift;
+        const float split = axis == 0 ? px[i] : (axis == 1 ? py[i] : pz[i]);
+        const float saved = e.hi[axis];
+        e.hi[axis] = split;
+        const bool goLeft = segmentMeetsBox(seg, inv, e.lo, e.hi, radiusOf_[bound_[left]]);
+        e.hi[axis] = saved;
+        const float savedLo = e.lo[axis];
+        e.lo[axis] = split;
+        const bool goRight = left + 1 < n && segmentMeetsBox(seg, inv, e.lo, e.hi, radiusOf_[bound_[left + 1]]);
+        if (goRight && goLeft) {
+          if (top + 1 > int(q.stack_.size())) {  // cannot happen for a balanced tree; stay safe
+            q.stack_.resize(q.stack_.size() * 2);
+            stack = q.stack_.data();
+          }
+          auto& r = stack[top++];
+          r = e;
+          r.node = left + 1;
+        }
+        if (goLeft) {
+          e.lo[axis] = savedLo;
+          e.hi[axis] = split;
+          e.node = left;
+          continue;
+        }
+        if (goRight) {
+          e.node = left + 1;
+          continue;
+        }
+      }
     }
-    auto& l = stack[top++];
-    l = e;
-    l.node = left;
-    l.hi[axis] = split;
-    if (left + 1 < n) {
-      auto& r = stack[top++];
-      r = e;
-      r.node = left + 1;
-      r.lo[axis] = split;
-    }
+    if (top == 0) break;
+    e = stack[--top];
   }
 }
 

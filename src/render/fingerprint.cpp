@@ -98,6 +98,9 @@ std::map<std::string, std::string> renderSettings(const RenderOptions& o, int wi
   // media keeps its fingerprint.
   for (MapKind k : kAllMapKinds)
     if (mapKindInUse(o, k)) s[mapKindInfo(k).optionName] = std::to_string(o.*mapKindInfo(k).photons);
+  // Likewise the volume kernels' k, only when --volume-k set it (else the
+  // progressive default is k_s, already in the fingerprint).
+  if (mapKindInUse(o, MapKind::Volume) && o.volumeK > 0) s["volume_k"] = std::to_string(o.volumeK);
   // Progressive passes' per-pixel sample counts (render/sample_allocation.h):
   // one key, present only when they are on, so that a render without them
   // keeps the fingerprint it had before they existed.

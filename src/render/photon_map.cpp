@@ -47,7 +47,7 @@ PerMap<PhotonMapSettings> photonMapSettingsFor(const RenderOptions& opt, const P
   photon::BeamBuildOptions& beam = all[MapKind::Volume].beam;
   beam.kind = renderMethodTraits(opt.method).timeDependentEstimate ? photon::BeamBuildOptions::Kind::Time
                                                                    : photon::BeamBuildOptions::Kind::Standard;
-  beam.ks = opt.estimate.ks;
+  beam.ks = opt.effectiveVolumeK();
   beam.fraction = opt.estimate.fraction;
   beam.maxTimeDistance = opt.estimate.maxTimeDistance;
   beam.minTimePhotons = estimate::kMinTimePhotons;

@@ -58,6 +58,20 @@ struct RenderOptions {
   // kDefaultVolumePhotons; --volume-photons, render.volume_photons).
   size_t volumePhotons = 0;
   static constexpr size_t kDefaultVolumePhotons = 100000;
+  // k of the volume photons' beam kernels (photon/volume_beam_map.h): the
+  // disc radius is the distance to the k-th nearest volume photon. A
+  // segment of length L crosses about (3/4) k L / r discs, so the query's
+  // cost grows as k^(2/3); the surface estimates' k (100) made ~1,300
+  // crossings a camera ray in thin fog (docs/media.md, "The beam query's
+  // cost"). --volume-k; 0: kDefaultVolumeK with a fixed budget, the
+  // surface k_s (as before --volume-k) for progressive passes, whose pilot
+  // kernel is the median of these radii and whose measured convergence
+  // (tests/test_media_progressive.cpp) was made with them: at 32 the
+  // passes' mean lands 20% high instead of 30% low, and does not approach
+  // pathtrace faster (docs/media.md).
+  int volumeK = 0;
+  static constexpr int kDefaultVolumeK = 32;
+  int effectiveVolumeK() const { return volumeK > 0 ? volumeK : progressive ? estimate.ks : kDefaultVolumeK; }
   int frames = 8;                  // accumulation: in-between frames
   bool spaceTime4D = false;        // --search 4d
   float kappa = 1.0f;              // 4D metric weight

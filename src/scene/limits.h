@@ -95,6 +95,9 @@ constexpr IntRange kMaxDepth{1, 1024};
 constexpr IntRange kFrames{1, 4096};
 constexpr IntRange kPasses{1, int64_t(1) << 24};  // progressive passes
 constexpr IntRange kK{1, 4096};
+// --volume-k: at least 2 (the k-th closes the disc; the time window needs
+// neighbours strictly inside it).
+constexpr IntRange kVolumeK{2, 4096};
 constexpr IntRange kGather{0, 1024};
 // 2^31 photons at 20 bytes is 40 GiB: more is certainly a typo.
 constexpr IntRange kPhotons{0, int64_t(1) << 31};
