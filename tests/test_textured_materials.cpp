@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_harness.h"
+#include "convert_round_trip.h"
 #include "error_capture.h"
 #include "image/image.h"
 #include "import/pbrt_import.h"
@@ -71,21 +72,7 @@ void checkHalves(const scene::SceneDescription& textured, const scene::SceneDesc
   CHECK(test::imageSum(t) > 0);
 }
 
-// The JSON `tdpm convert` writes for d: its text, and it reads back to the
-// same JSON and renders the same, non-black pixels.
-std::string checkConvert(const scene::SceneDescription& d, const std::string& json) {
-  pbrt::writeSceneJson(d, json);
-  std::ifstream in(json);
-  std::string written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  scene::SceneDescription back = scene::loadScene(json);
-  CHECK(nlohmann::json::parse(pbrt::sceneToJson(back, "/x/s.json").json) ==
-        nlohmann::json::parse(pbrt::sceneToJson(d, "/x/s.json").json));
-  RenderOptions o = test::smallRenderOptions(RenderMethod::PathTrace, 4, 4, 11);
-  Film a = test::renderOnce(d, o), b = test::renderOnce(back, o);
-  CHECK(test::sameImage(a, b));
-  CHECK(test::imageSum(a) > 0);
-  return written;
-}
+using test::checkConvert;  // tests/convert_round_trip.h
 
 const char* kCheckers = R"("eta": {"type": "checkerboard", "uscale": 2, "tex1": [0.2, 0.9, 1.1], "tex2": [1.5, 1.2, 0.5]},
     "k": {"type": "checkerboard", "uscale": 2, "tex1": [3.9, 2.4, 2.1], "tex2": [1.0, 2.0, 3.0]},

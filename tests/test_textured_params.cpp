@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_harness.h"
+#include "convert_round_trip.h"
 #include "error_capture.h"
 #include "import/pbrt_import.h"
 #include "render_fixtures.h"
@@ -84,21 +85,7 @@ void checkSame(const scene::SceneDescription& a, const scene::SceneDescription& 
   CHECK(test::imageSum(fa) > 0);
 }
 
-// The JSON `tdpm convert` writes for d: it reads back to the same JSON and
-// renders the same, non-black pixels. Returns the text.
-std::string checkConvert(const scene::SceneDescription& d, const std::string& json) {
-  pbrt::writeSceneJson(d, json);
-  std::ifstream in(json);
-  std::string written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  scene::SceneDescription back = scene::loadScene(json);
-  CHECK(nlohmann::json::parse(pbrt::sceneToJson(back, "/x/s.json").json) ==
-        nlohmann::json::parse(pbrt::sceneToJson(d, "/x/s.json").json));
-  RenderOptions o = test::smallRenderOptions(RenderMethod::PathTrace, 4, 4, 11);
-  Film a = test::renderOnce(d, o), b = test::renderOnce(back, o);
-  CHECK(test::sameImage(a, b));
-  CHECK(test::imageSum(a) > 0);
-  return written;
-}
+using test::checkConvert;  // tests/convert_round_trip.h
 
 // The material named "m" (the JSON's materials are read in name order).
 const scene::MaterialDesc& materialM(const scene::SceneDescription& d) {
