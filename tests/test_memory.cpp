@@ -255,3 +255,24 @@ TEST_CASE("memory: a photon budget that cannot fit fails before any work, with t
   CHECK(r.output.find("--photons") != std::string::npos);
   CHECK(test::countEntries(dir) == 2);
 }
+
+TEST_CASE("memory: an animation block's kept path states are checked against the memory available") {
+  const uint64_t GiB = uint64_t(1) << 30;
+  // 10M paths of 56 bytes = 560 MB: fits 8 GiB, not 512 MiB (margin 256 MiB + 1/16).
+  CHECK_NOTHROW(checkKeptStatesMemory(10000000, 56, 0, 8 * GiB, 4));
+  std::string e;
+  try {
+    checkKeptStatesMemory(10000000, 56, 0, GiB / 2, 4);
+  } catch (const std::exception& ex) {
+    e = ex.what();
+  }
+  INFO(e);
+  CHECK(e.find("block of 4 frames traces 10000000 photon paths") != std::string::npos);
+  CHECK(e.find("--no-continue-paths") != std::string::npos);
+  CHECK(e.find("MemAvailable") != std::string::npos);
+  // What the block already holds counts: 1.2 GiB of states held tip 1.5 GiB (usable 1184 MiB), 1 GiB does not.
+  CHECK_NOTHROW(checkKeptStatesMemory(1000000, 56, 0, 3 * GiB / 2, 4));
+  CHECK_THROWS(checkKeptStatesMemory(1000000, 56, GiB + GiB / 5, 3 * GiB / 2, 4));
+  CHECK_NOTHROW(checkKeptStatesMemory(1000000, 56, GiB, 3 * GiB / 2, 4));
+  CHECK_NOTHROW(checkKeptStatesMemory(uint64_t(1) << 40, 56, 0, 0, 4));  // unknown memory: no check
+}

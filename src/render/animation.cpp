@@ -333,6 +333,15 @@ class SegmentTimeline {
       photon::TraceSettings ts = traceSettingsFor(
           opt_, kind, size_t(std::max(1.0, std::round(double(perShutter_[kind]) * mapShare * ao_.sharedScale))),
           hashCombine(opt_.seed, 0x5a4edull, key));
+      if (continuing()) {
+        // Before tracing: every path of the block may meet motion and keep a
+        // state (the rolling ball's caustic paths all do), as many paths as
+        // the pilot's rate says, on top of the states already kept.
+        const uint64_t paths = uint64_t(std::ceil(double(ts.storedWanted) / rate));
+        checkKeptStatesMemory(paths, sizeof(photon::PathState),
+                              uint64_t(shared_.keptStates()) * sizeof(photon::PathState), availableMemoryBytes(),
+                              ao_.window);
+      }
       ts.timeOpen = t0;
       ts.timeClose = t1;
       ts.invariant = photon::InvariantPhotons::Only;

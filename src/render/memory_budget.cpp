@@ -100,6 +100,20 @@ uint64_t photonMemoryBytes(const PerMap<size_t>& stored, bool spaceTime4D, int m
 
 uint64_t memoryMarginBytes(uint64_t available) { return (uint64_t(256) << 20) + available / 16; }
 
+void checkKeptStatesMemory(uint64_t paths, uint64_t bytesPerState, uint64_t held, uint64_t available, int window) {
+  if (available == 0) return;
+  const uint64_t margin = memoryMarginBytes(available);
+  const uint64_t usable = available > margin ? available - margin : 0;
+  const double needed = double(paths) * double(bytesPerState) + double(held);
+  if (needed <= double(usable)) return;
+  throw Error("the animation's block of " + std::to_string(window) + " frames traces " + std::to_string(paths) +
+              " photon paths, and continuing the paths that meet motion may keep a state of each (" +
+              formatBytes(uint64_t(needed)) + " with what the block holds), but only " + formatBytes(usable) +
+              " of memory is available (MemAvailable " + formatBytes(available) + " less a margin of " +
+              formatBytes(margin) + "); lower --window or the photon counts, or trace every frame from the light "
+              "with --no-continue-paths");
+}
+
 void checkPhotonMemory(const PerMap<size_t>& stored, bool spaceTime4D, int maxDepth, uint64_t available,
                        const PerMap<std::string>& sources) {
   if (available == 0) return;  // unknown: better to try than to refuse

@@ -41,6 +41,14 @@ uint64_t memoryMarginBytes(uint64_t available);
 void checkPhotonMemory(const PerMap<size_t>& stored, bool spaceTime4D, int maxDepth, uint64_t available,
                        const PerMap<std::string>& sources);
 
+// An animation block's kept path states (render/animation.cpp, section 8 of
+// docs/animation.md): at most one per block path of each kind, `paths` in
+// all, `bytesPerState` each, on top of `held` bytes the block already holds.
+// Throws tdpm::Error (naming --window and --no-continue-paths) when that
+// worst case exceeds `available` less memoryMarginBytes; available == 0
+// means unknown: no check.
+void checkKeptStatesMemory(uint64_t paths, uint64_t bytesPerState, uint64_t held, uint64_t available, int window);
+
 struct MemoryEstimate {
   uint64_t pixels = 0;
   uint64_t films = 0;    // the films alive while rendering (accumulation: 3)
