@@ -57,8 +57,10 @@ struct AnimationOptions {
   // block uses them all. The frames' own segments keep only the photons
   // whose path meets motion, traced with `movingScale` times their paths.
   // sharedScale 0: no sharing (every frame traces all its photons).
-  double sharedScale = 1.0;
-  double movingScale = 0.5;  // measured default: docs/animation.md "Defaults and what they buy"
+  // Measured defaults (continuing the paths that meet motion, --window 4,
+  // 8 seeds): docs/animation.md "Defaults and what they buy".
+  double sharedScale = 0.5;
+  double movingScale = 0.5;
   // With sharing: the frames' photons whose path meets motion are continued
   // from the block pass's paths at their last time-invariant vertex
   // instead of traced from the light (docs/animation.md section 8). Scenes
