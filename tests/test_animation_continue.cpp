@@ -17,37 +17,16 @@
 #include "render/renderer.h"
 #include "scene/scene.h"
 #include "scene_fixtures.h"
+#include "shadow_sweep.h"
 
 using namespace tdpm;
 
 namespace {
 
-constexpr Vec3f kLight{0, 3, 0};
-constexpr float kPower = 400.0f;
+constexpr Vec3f kLight = test::kSweepLight;  // tests/shadow_sweep.h
+constexpr float kPower = test::kSweepPower;
 
-// A still floor (albedo 0.5) under a still point light 3 m above it, and a
-// thin slab at y = 1.5 (0.5 x 0.05 x 0.5) crossing from x = -1.2
-// to 1.2 over the timeline [0, 1] s (4 frames at 4 fps, 180 degrees): its
-// shadow sweeps over the floor.
-scene::SceneDescription shadowSweep(int res) {
-  auto d = test::emptyScene(res, res);
-  d.camera.position = {0, 5, 0};
-  d.camera.target = {0, 0, 0};
-  d.camera.up = {0, 0, -1};
-  d.camera.fovDegrees = 40;
-  d.materials.push_back(test::diffuse(Rgb(0.5f)));
-  d.objects.push_back(test::quad({8, 8}, {0, 0, 0}, 0));
-  auto slab = test::box({0.5f, 0.05f, 0.5f}, {0, 1.5f, 0}, 0);
-  slab.motion = test::translation({-1.2f, 0, 0}, {1.2f, 0, 0});
-  d.objects.push_back(slab);
-  scene::LightDesc l;
-  l.type = scene::LightDesc::Type::Point;
-  l.position = kLight;
-  l.power = Rgb(kPower);
-  d.lights.push_back(l);
-  d.animation = scene::AnimationDesc{4.0, 4, 180.0};
-  return d;
-}
+using test::shadowSweep;  // tests/shadow_sweep.h
 
 // The floor rectangle R the test reads: x in [-2, -0.8], z in [-0.4, 0.4].
 // Every light -> R segment crosses the slab's swept bounds over the block

@@ -23,36 +23,15 @@
 #include "scene/scene.h"
 #include "moving_plane.h"
 #include "scene_fixtures.h"
+#include "shadow_sweep.h"
 
 using namespace tdpm;
 
 namespace {
 
-constexpr Vec3f kLight{0, 3, 0};
+constexpr Vec3f kLight = test::kSweepLight;  // tests/shadow_sweep.h
 
-// A still floor (albedo 0.5) lit by a still point light 3 m above, and the
-// only moving thing: a thin slab at y = 1.5 crossing from x = -1.2 to 1.2
-// over the timeline (4 frames at 4 fps, 180 degrees), whose shadow sweeps
-// over the floor. Seen from above.
-scene::SceneDescription shadowSweep(int res) {
-  auto d = test::emptyScene(res, res);
-  d.camera.position = {0, 5, 0};
-  d.camera.target = {0, 0, 0};
-  d.camera.up = {0, 0, -1};
-  d.camera.fovDegrees = 40;
-  d.materials.push_back(test::diffuse(Rgb(0.5f)));
-  d.objects.push_back(test::quad({8, 8}, {0, 0, 0}, 0));
-  auto slab = test::box({0.5f, 0.05f, 0.5f}, {0, 1.5f, 0}, 0);
-  slab.motion = test::translation({-1.2f, 0, 0}, {1.2f, 0, 0});
-  d.objects.push_back(slab);
-  scene::LightDesc l;
-  l.type = scene::LightDesc::Type::Point;
-  l.position = kLight;
-  l.power = Rgb(400.0f);
-  d.lights.push_back(l);
-  d.animation = scene::AnimationDesc{4.0, 4, 180.0};
-  return d;
-}
+using test::shadowSweep;  // tests/shadow_sweep.h
 
 RenderOptions shadowOptions(uint64_t seed) {
   RenderOptions o;

@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_harness.h"
-#include "convert_round_trip.h"
+#include "texture_checks.h"
 #include "error_capture.h"
 #include "image/image.h"
 #include "import/pbrt_import.h"
@@ -49,30 +49,9 @@ Material shadedBelow(const Scene& s, float x, float z) {
   return s.shadedMaterial(s.materialAt(h, {0, 1, 0}), h, scratch);
 }
 
-// The textured scene's left six columns are the pixels of scene a, its
-// right six those of scene b (the seam's columns, which the pixel filter
-// spans, left out), and a and b differ there: the test can fail.
-void checkHalves(const scene::SceneDescription& textured, const scene::SceneDescription& a,
-                 const scene::SceneDescription& b, RenderMethod method = RenderMethod::PathTrace) {
-  RenderOptions o = test::smallRenderOptions(method, 4, 3, 5);
-  Film t = test::renderOnce(textured, o), fa = test::renderOnce(a, o), fb = test::renderOnce(b, o);
-  REQUIRE(t.width == 16);
-  int sameA = 0, sameB = 0, differ = 0, n = 0;
-  auto same = [](Rgb p, Rgb q) { return p.r == q.r && p.g == q.g && p.b == q.b; };
-  for (int y = 0; y < t.height; ++y)
-    for (int x = 0; x < 6; ++x, ++n) {
-      size_t l = size_t(y) * 16 + size_t(x), r = size_t(y) * 16 + size_t(15 - x);
-      sameA += same(t.color[l], fa.color[l]);
-      sameB += same(t.color[r], fb.color[r]);
-      differ += !same(fa.color[l], fb.color[l]) + !same(fa.color[r], fb.color[r]);
-    }
-  CHECK(sameA == n);
-  CHECK(sameB == n);
-  CHECK(differ > n);
-  CHECK(test::imageSum(t) > 0);
-}
+using test::checkHalves;  // tests/texture_checks.h
 
-using test::checkConvert;  // tests/convert_round_trip.h
+using test::checkConvert;  // tests/texture_checks.h
 
 const char* kCheckers = R"("eta": {"type": "checkerboard", "uscale": 2, "tex1": [0.2, 0.9, 1.1], "tex2": [1.5, 1.2, 0.5]},
     "k": {"type": "checkerboard", "uscale": 2, "tex1": [3.9, 2.4, 2.1], "tex2": [1.0, 2.0, 3.0]},
@@ -192,26 +171,19 @@ TEST_CASE("textured mix amount: photon classification from the components, whate
 
 namespace {
 
-// A pbrt scene: a 2 x 2 uv quad seen from above under a distant light, `body` its material and textures.
-std::string pbrtPlane(const std::string& body) {
-  return "LookAt 0 3 0  0 0 0  0 0 -1\nCamera \"perspective\" \"float fov\" 30\n"
-         "Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 16\nWorldBegin\n"
-         "LightSource \"distant\" \"rgb L\" [3 3 3] \"point3 from\" [0.3 1 -0.2] \"point3 to\" [0 0 0]\n"
-         "Texture \"kd\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"rgb tex1\" [0.7 0.2 0.1] \"rgb tex2\" [0.1 0.3 0.8]\n"
-         "Texture \"refl\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"rgb tex1\" [0.9 0.5 0.2] \"rgb tex2\" [0.3 0.6 0.95]\n"
-         "Texture \"e\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"rgb tex1\" [0.2 0.9 1.1] \"rgb tex2\" [1.5 1.2 0.5]\n"
-         "Texture \"amt\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float tex1\" 0.25 \"float tex2\" 0.75\n"
-         "MakeNamedMaterial \"red\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.8 0.1 0.1]\n"
-         "MakeNamedMaterial \"blue\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.1 0.2 0.8]\n" +
-         body + "\nShape \"bilinearmesh\" \"point3 P\" [-1 0 -1 1 0 -1 -1 0 1 1 0 1] \"point2 uv\" [0 0 1 0 0 1 1 1]\n";
-}
+// The plane's textures and named materials (tests/texture_checks.h pbrtPlane).
+const std::string kPbrtDefs =
+    "Texture \"kd\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"rgb tex1\" [0.7 0.2 0.1] \"rgb tex2\" [0.1 0.3 0.8]\n"
+    "Texture \"refl\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"rgb tex1\" [0.9 0.5 0.2] \"rgb tex2\" [0.3 0.6 0.95]\n"
+    "Texture \"e\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"rgb tex1\" [0.2 0.9 1.1] \"rgb tex2\" [1.5 1.2 0.5]\n"
+    "Texture \"amt\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float tex1\" 0.25 \"float tex2\" 0.75\n"
+    "MakeNamedMaterial \"red\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.8 0.1 0.1]\n"
+    "MakeNamedMaterial \"blue\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.1 0.2 0.8]\n";
 
-scene::SceneDescription importText(const std::string& text) { return pbrt::importPbrtText(text, "dir/t.pbrt").scene; }
-
-// pbrt's image is mirrored in x against tdpm's camera frame (pbrt_import.cpp):
-// the checkerboard's tex1 (u < 1/2) is on the image's right there.
+std::string pbrtPlane(const std::string& body) { return test::pbrtPlane(kPbrtDefs, body); }
+using test::importText;
 void checkPbrtHalves(const std::string& textured, const std::string& tex1, const std::string& tex2) {
-  checkHalves(importText(pbrtPlane(textured)), importText(pbrtPlane(tex2)), importText(pbrtPlane(tex1)));
+  test::checkPbrtHalves(kPbrtDefs, textured, tex1, tex2);
 }
 
 }  // namespace

@@ -18,7 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_harness.h"
-#include "convert_round_trip.h"
+#include "texture_checks.h"
 #include "error_capture.h"
 #include "import/pbrt_import.h"
 #include "render_fixtures.h"
@@ -57,27 +57,7 @@ scene::SceneDescription jsonScene(const std::string& material, const std::string
 
 RenderOptions pathOptions(int spp = 4, uint64_t seed = 5) { return test::smallRenderOptions(RenderMethod::PathTrace, spp, 3, seed); }
 
-// The textured scene's left six columns are scene a's pixels, its right
-// six scene b's (the seam's columns, which the pixel filter spans, left
-// out), and a and b differ there: the test can fail.
-void checkHalves(const scene::SceneDescription& textured, const scene::SceneDescription& a, const scene::SceneDescription& b) {
-  RenderOptions o = pathOptions();
-  Film t = test::renderOnce(textured, o), fa = test::renderOnce(a, o), fb = test::renderOnce(b, o);
-  REQUIRE(t.width == 16);
-  int sameA = 0, sameB = 0, differ = 0, n = 0;
-  auto same = [](Rgb p, Rgb q) { return p.r == q.r && p.g == q.g && p.b == q.b; };
-  for (int y = 0; y < t.height; ++y)
-    for (int x = 0; x < 6; ++x, ++n) {
-      size_t l = size_t(y) * 16 + size_t(x), r = size_t(y) * 16 + size_t(15 - x);
-      sameA += same(t.color[l], fa.color[l]);
-      sameB += same(t.color[r], fb.color[r]);
-      differ += !same(fa.color[l], fb.color[l]) + !same(fa.color[r], fb.color[r]);
-    }
-  CHECK(sameA == n);
-  CHECK(sameB == n);
-  CHECK(differ > n);
-  CHECK(test::imageSum(t) > 0);
-}
+using test::checkHalves;  // tests/texture_checks.h
 
 void checkSame(const scene::SceneDescription& a, const scene::SceneDescription& b) {
   Film fa = test::renderOnce(a, pathOptions()), fb = test::renderOnce(b, pathOptions());
@@ -85,7 +65,7 @@ void checkSame(const scene::SceneDescription& a, const scene::SceneDescription& 
   CHECK(test::imageSum(fa) > 0);
 }
 
-using test::checkConvert;  // tests/convert_round_trip.h
+using test::checkConvert;  // tests/texture_checks.h
 
 // The material named "m" (the JSON's materials are read in name order).
 const scene::MaterialDesc& materialM(const scene::SceneDescription& d) {
@@ -297,25 +277,18 @@ TEST_CASE("per-channel mix amount (1, 0, 0) with photons: the ceiling lit by the
 
 namespace {
 
-// A pbrt scene: a 2 x 2 uv quad seen from above under a distant light, `body` its material and textures.
-std::string pbrtPlane(const std::string& body) {
-  return "LookAt 0 3 0  0 0 0  0 0 -1\nCamera \"perspective\" \"float fov\" 30\n"
-         "Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 16\nWorldBegin\n"
-         "LightSource \"distant\" \"rgb L\" [3 3 3] \"point3 from\" [0.3 1 -0.2] \"point3 to\" [0 0 0]\n"
-         "Texture \"sig\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float tex1\" 0 \"float tex2\" 25\n"
-         "Texture \"thick\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float tex1\" 0.01 \"float tex2\" 0.6\n"
-         "Texture \"amt\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"rgb tex1\" [0.9 0.2 0.1] \"rgb tex2\" [0.1 0.5 0.8]\n"
-         "MakeNamedMaterial \"red\" \"string type\" \"matte\" \"rgb Kd\" [0.8 0.1 0.1]\n"
-         "MakeNamedMaterial \"blue\" \"string type\" \"matte\" \"rgb Kd\" [0.1 0.2 0.8]\n" +
-         body + "\nShape \"bilinearmesh\" \"point3 P\" [-1 0 -1 1 0 -1 -1 0 1 1 0 1] \"point2 uv\" [0 0 1 0 0 1 1 1]\n";
-}
+// The plane's textures and named materials (tests/texture_checks.h pbrtPlane).
+const std::string kPbrtDefs =
+    "Texture \"sig\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float tex1\" 0 \"float tex2\" 25\n"
+    "Texture \"thick\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float tex1\" 0.01 \"float tex2\" 0.6\n"
+    "Texture \"amt\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"rgb tex1\" [0.9 0.2 0.1] \"rgb tex2\" [0.1 0.5 0.8]\n"
+    "MakeNamedMaterial \"red\" \"string type\" \"matte\" \"rgb Kd\" [0.8 0.1 0.1]\n"
+    "MakeNamedMaterial \"blue\" \"string type\" \"matte\" \"rgb Kd\" [0.1 0.2 0.8]\n";
 
-scene::SceneDescription importText(const std::string& text) { return pbrt::importPbrtText(text, "dir/t.pbrt").scene; }
-
-// pbrt's image is mirrored in x against tdpm's camera frame: the
-// checkerboard's tex1 (u < 1/2) is on the image's right.
+std::string pbrtPlane(const std::string& body) { return test::pbrtPlane(kPbrtDefs, body); }
+using test::importText;
 void checkPbrtHalves(const std::string& textured, const std::string& tex1, const std::string& tex2) {
-  checkHalves(importText(pbrtPlane(textured)), importText(pbrtPlane(tex2)), importText(pbrtPlane(tex1)));
+  test::checkPbrtHalves(kPbrtDefs, textured, tex1, tex2);
 }
 
 }  // namespace
