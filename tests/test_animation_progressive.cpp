@@ -3,16 +3,22 @@
 // frames"): a progressive frame converges to the fixed-budget frame's mean
 // and to the analytic value of its own part of the timeline; --passes is
 // per frame and a frame's image does not depend on the frame range; on the
-// command line the frames are written, and --resume is refused.
+// command line the frames are written with their states, and --resume
+// continues each frame (one state file per frame).
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "cli_harness.h"
+#include "image/exr.h"
 #include "render/animation.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
@@ -178,7 +184,19 @@ TEST_CASE("progressive animation frames: --passes per frame, a frame's image wha
   CHECK(meanRed(range.films[0]) != meanRed(range.films[1]));
 }
 
-TEST_CASE("render CLI: --progressive renders an animation's frames in passes; --resume is refused and writes nothing") {
+std::string readBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Frame i's pixels as bytes, for bit-for-bit comparisons.
+std::string framePixels(const std::string& path) {
+  image::ExrFile e = image::readExr(path);
+  return std::string(reinterpret_cast<const char*>(e.color.pixels.data()), e.color.pixels.size() * sizeof(Rgb));
+}
+
+TEST_CASE("render CLI: --progressive animation frames carry their state; --resume continues each frame bit for bit, "
+          "skips finished ones, and refuses another render's state") {
   std::string dir = test::makeTempDir();
   const std::string scene = dir + "/anim.json";
   test::writeFile(scene, R"({"animation": {"fps": 24, "frames": 3},
@@ -188,18 +206,50 @@ TEST_CASE("render CLI: --progressive renders an animation's frames in passes; --
    {"shape": {"type": "sphere", "radius": 0.4}, "material": "glass", "transform": {"translate": [0, 0.6, 0]},
     "motion": [{"time": 0, "translate": [-1, 0, 0]}, {"time": 0.12, "translate": [1, 0, 0]}]}],
  "lights": [{"type": "point", "position": [0, 3, 0], "power": [200, 200, 200]}]})");
-  auto r = test::runTdpm("render '" + scene + "' -o '" + dir + "/out/f_#.exr' --progressive --passes 2 --spp 1 "
-                         "--photons 2000 --global-photons 1000 -t 2");
+  const std::string flags = " --progressive --spp 1 --photons 2000 --global-photons 1000 -t 2";
+  auto r = test::runTdpm("render '" + scene + "' -o '" + dir + "/out/f_#.exr' --passes 2" + flags);
   INFO(r.output);
   REQUIRE(r.exitCode == 0);
   for (int i : {0, 1, 2}) CHECK(test::fileExists(dir + "/out/f_" + std::to_string(i) + ".exr"));
   CHECK(r.output.find("stored in 6 passes") != std::string::npos);  // 2 passes for each of the 3 frames
-  int before = test::countEntries(dir);
-  auto bad = test::runTdpm("render '" + scene + "' -o '" + dir + "/out2/f_#.exr' --progressive --passes 2 --resume '" +
-                           dir + "/out/f_0.exr' --spp 1 --photons 100 --global-photons 100");
+  // Frames 0 and 1 resumed in place to 4 passes (frame 2's file removed: it starts from pass 0).
+  std::remove((dir + "/out/f_2.exr").c_str());
+  auto res = test::runTdpm("render '" + scene + "' -o '" + dir + "/out/f_#.exr' --passes 4 --resume '" + dir +
+                           "/out/f_#.exr'" + flags);
+  INFO(res.output);
+  REQUIRE(res.exitCode == 0);
+  CHECK(res.output.find("stored in 8 passes") != std::string::npos);  // 2 more for frames 0, 1; 4 for frame 2
+  auto whole = test::runTdpm("render '" + scene + "' -o '" + dir + "/ref/f_#.exr' --passes 4" + flags);
+  INFO(whole.output);
+  REQUIRE(whole.exitCode == 0);
+  for (int i : {0, 1, 2}) {
+    const std::string n = "/f_" + std::to_string(i) + ".exr";
+    CHECK(framePixels(dir + "/out" + n) == framePixels(dir + "/ref" + n));
+  }
+  // Finished frames are skipped: no pass is traced, the files stay.
+  const std::string before0 = readBytes(dir + "/out/f_0.exr");
+  auto again = test::runTdpm("render '" + scene + "' -o '" + dir + "/out/f_#.exr' --passes 4 --resume '" + dir +
+                             "/out/f_#.exr'" + flags);
+  INFO(again.output);
+  REQUIRE(again.exitCode == 0);
+  CHECK(again.output.find("stored in 0 passes") != std::string::npos);
+  CHECK(readBytes(dir + "/out/f_0.exr") == before0);
+  // Another render's state (other --photons): a located error, nothing written.
+  int entries = test::countEntries(dir);
+  auto bad = test::runTdpm("render '" + scene + "' -o '" + dir + "/out/f_#.exr' --passes 6 --resume '" + dir +
+                           "/out/f_#.exr' --progressive --spp 1 --photons 100 --global-photons 1000 -t 2");
   INFO(bad.output);
   CHECK(bad.exitCode == 1);
-  CHECK(bad.output.find("--resume") != std::string::npos);
-  CHECK(bad.output.find("anim.json is an animation, and its progressive frames cannot be resumed") != std::string::npos);
-  CHECK(test::countEntries(dir) == before);
+  CHECK(bad.output.find("--resume " + dir + "/out/f_0.exr: it is another render") != std::string::npos);
+  CHECK(bad.output.find("photons: 2000") != std::string::npos);
+  CHECK(test::countEntries(dir) == entries);
+  CHECK(readBytes(dir + "/out/f_0.exr") == before0);
+  // Frame 1's state resumed as frame 0's: refused by its shutter.
+  std::filesystem::create_directories(dir + "/swap");
+  test::writeFile(dir + "/swap/f_0.exr", readBytes(dir + "/out/f_1.exr"));
+  auto swapped = test::runTdpm("render '" + scene + "' -o '" + dir + "/swap/f_#.exr' --frame-range 0-0 --passes 6 --resume '" +
+                               dir + "/swap/f_#.exr'" + flags);
+  INFO(swapped.output);
+  CHECK(swapped.exitCode == 1);
+  CHECK(swapped.output.find("frame_shutter") != std::string::npos);
 }

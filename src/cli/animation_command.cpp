@@ -22,6 +22,7 @@
 #include "distributed/comm.h"
 #include "photon/tracer.h"
 #include "cli/progress_bar.h"
+#include "cli/resume.h"
 #include "cli/render_metadata.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -32,6 +33,7 @@
 #include "image/png.h"
 #include "render/animation.h"
 #include "render/film_output.h"
+#include "render/progressive_io.h"
 #include "render/threads.h"
 #include "scene/scene.h"
 
@@ -214,6 +216,35 @@ void prepareFrameOutputs(const RenderArgs& a, const scene::AnimationDesc& anim, 
   }
 }
 
+// --progressive: frame i starts from the state in --resume's frame i file
+// when that file exists (checked as still resume checks it, against the
+// frame's own options), else from a fresh state with the frame's
+// fingerprint, which the frame's EXR then carries (docs/animation.md
+// "Resuming progressive frames").
+ProgressiveState frameStartState(const RenderArgs& a, const scene::SceneDescription& desc, int frame,
+                                 const RenderOptions& frameOptions) {
+  if (a.resume) {
+    const std::string path = formatFramePath(*a.resume, frame);
+    std::error_code ec;
+    if (fs::exists(path, ec)) return loadResumeState(path, desc, frameOptions);
+  }
+  return initialProgressiveState(nullptr, desc, frameOptions);
+}
+
+// Every frame's --resume file is checked before any frame is rendered, so a
+// wrong one costs no render and writes nothing.
+void checkResumeFiles(const RenderArgs& a, const scene::SceneDescription& desc, const scene::AnimationDesc& anim,
+                      const RenderOptions& opt, int first, int last) {
+  if (!a.resume) return;
+  for (int i = first; i <= last; ++i) {
+    RenderOptions fo = opt;
+    const Shutter sh = frameShutter(anim, i);
+    fo.frameOpen = sh.open;
+    fo.frameClose = sh.close;
+    (void)frameStartState(a, desc, i, fo);
+  }
+}
+
 // One written frame, for the summary.
 struct FrameLine {
   int frame;
@@ -307,18 +338,29 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
   ao.sharedScale = a.sharedPhotons.value_or(ao.sharedScale);
   ao.movingScale = a.movingPhotons.value_or(ao.movingScale);
   if (a.continuePaths || a.noContinuePaths) ao.continuePaths = a.continuePaths;
+  std::optional<ProgressiveState> kept;  // the frame's state, written with it
+  if (opt.progressive) {
+    ao.startState = [&](int i, const RenderOptions& fo) { return frameStartState(a, descIn, i, fo); };
+    ao.keepState = [&](int, ProgressiveState&& st) { kept = std::move(st); };
+  }
   std::vector<FrameLine> lines;
   uint64_t peakRss = 0;
   Timer frameTimer;
   AnimationStats stats;
   std::string frameError;
   try {
+    if (opt.progressive && ao.first <= ao.last) {
+      if (a.resume) checkFramePattern(*a.resume, f.range, "--resume");
+      checkResumeFiles(a, descIn, anim, opt, ao.first, ao.last);
+    }
     if (ao.first <= ao.last)
       stats = renderAnimation(*scene, anim, opt, ao, bar.progress(), [&](int i, Film&& film, const RenderStats& st) {
         size_t k = size_t(i - f.range.first);
         image::ExrFile exr = filmToExr(std::move(film));
         const FrameTag tag{i, double(anim.frameOpen(i)), double(anim.frameClose(i))};
         exr.metadata = renderMetadata(a.scene, opt, st, &tag);
+        if (kept) addProgressiveState(std::move(*kept), exr);
+        kept.reset();
         writeRenderOutputs(f.outputs[k], f.previews[k], exr, exposure);
         lines.push_back({i, frameTimer.seconds(), st.cameraSamples, st.minSpp, st.maxSpp});
         frameTimer.reset();

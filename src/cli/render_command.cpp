@@ -573,16 +573,10 @@ void loadRenderSetup(const RenderArgs& a, dist::Comm& comm, bool framePattern, R
 ProgressiveState startProgressiveState(const RenderArgs& a, const RenderSetup& s, dist::Comm& comm) {
   ProgressiveState state;
   if (!s.opt.progressive) return state;
-  // An animation's progressive frames each start from an empty state
-  // (render/animation.h); a frame's state is not kept, so nothing can be
-  // resumed (every rank sees the same flags: an agreed error).
-  if (s.desc.animation) {
-    if (a.resume)
-      throw dist::AgreedError("--resume " + *a.resume + ": " + a.scene +
-                              " is an animation, and its progressive frames cannot be resumed (each frame's passes "
-                              "start afresh; render the frames again, with more --passes)");
-    return state;
-  }
+  // An animation's progressive frames each have a state of their own, one
+  // file per frame (cli/animation_command.cpp reads --resume as a frame
+  // pattern).
+  if (s.desc.animation) return state;
   // Under mpirun rank 0 alone reads --resume and holds the state; the
   // pass loop sends the others what they need (render/progressive.h).
   std::string resumeError;

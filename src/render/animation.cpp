@@ -171,7 +171,13 @@ AnimationStats renderProgressiveFrames(const Scene& scene, const scene::Animatio
     const Shutter sh = frameShutter(anim, i);
     frameOpt.frameOpen = sh.open;
     frameOpt.frameClose = sh.close;
-    ProgressiveState state;
+    ProgressiveState state = ao.startState ? ao.startState(i, frameOpt) : ProgressiveState{};
+    if (opt.passes > 0 && state.passesDone >= opt.passes) {  // finished in an earlier run: its file stays
+      ++stats.framesSkipped;
+      progress.at(WorkPosition{"frame", size_t(i - ao.first + 1), total, 0, emitted});
+      continue;
+    }
+    const int resumedAt = state.passesDone;
     RenderStats st;
     Film film = renderProgressive(scene, frameOpt, state, framed, st);
     for (const std::string& w : st.warnings)
@@ -182,7 +188,8 @@ AnimationStats renderProgressiveFrames(const Scene& scene, const scene::Animatio
       stats.maps[k].emitted += st.maps[k].emitted;
       emitted += st.maps[k].emitted;
     }
-    stats.passesDone += uint64_t(state.passesDone);
+    stats.passesDone += uint64_t(state.passesDone - resumedAt);  // this run's
+    if (ao.keepState) ao.keepState(i, std::move(state));
     sink(i, std::move(film), st);
     progress.at(WorkPosition{"frame", size_t(i - ao.first + 1), total, 0, emitted});
   }

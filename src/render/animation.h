@@ -14,6 +14,7 @@
 #include "core/progress.h"
 #include "motion/shutter.h"
 #include "render/film.h"
+#include "render/progressive_state.h"
 #include "render/renderer.h"
 #include "scene/description.h"
 #include "scene/scene.h"
@@ -67,6 +68,14 @@ struct AnimationOptions {
   // with media always trace from the light. Measured default:
   // docs/animation.md section 8.
   bool continuePaths = true;
+  // --progressive with --resume (docs/animation.md "Resuming progressive
+  // frames"): the state frame `frame` starts from, given its options (with
+  // its shutter as frameOpen/frameClose); empty function: a fresh state.
+  // A frame whose state already has opt.passes passes is skipped (no pass,
+  // no sink call). keepState receives each rendered frame's final state
+  // just before the sink, so the caller can write it with the frame.
+  std::function<ProgressiveState(int frame, const RenderOptions& frameOptions)> startState;
+  std::function<void(int frame, ProgressiveState&& state)> keepState;
 };
 
 struct AnimationStats {
@@ -86,7 +95,8 @@ struct AnimationStats {
   // once, all kinds) and the frames' continued paths (of segmentPaths).
   size_t peakKeptStates = 0;
   uint64_t continuedPaths = 0;
-  uint64_t passesDone = 0;                    // --progressive: passes of all frames (no segments are traced)
+  uint64_t framesSkipped = 0;                 // --progressive --resume: frames already finished
+  uint64_t passesDone = 0;                    // --progressive: passes of all frames this run (no segments are traced)
   size_t peakHeldPhotons = 0;                 // segments + the frame's maps, at most
   std::vector<std::string> warnings;
 };

@@ -107,6 +107,9 @@ std::map<std::string, std::string> renderSettings(const RenderOptions& o, int wi
   if (o.passExtraSamples > 0 && o.passSampleCap > 1)
     s["extra_samples"] = floatText(o.passExtraSamples) + " (cap " + std::to_string(o.passSampleCap) + ")";
   if (o.directOnly) s["direct_only"] = "yes";  // likewise: only when on
+  // An animation frame rendered in passes: its shutter, so that frame i's
+  // state cannot be resumed as frame j's (only then: stills keep theirs).
+  if (std::isfinite(o.frameOpen)) s["frame_shutter"] = floatText(o.frameOpen) + " to " + floatText(o.frameClose);
   if (!o.gatherGuide) s["gather_guide"] = "off";  // likewise (only when off, its default since 2026-12): states made before it resume
   return s;
 }
