@@ -386,7 +386,8 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
                  "Continue the progressive render that wrote this EXR (needs --progressive): its passes, kept in the "
                  "file, are the start, and the new passes are averaged in. The scene and every setting that changes "
                  "the image must be the same (an error names what differs); --threads, --passes, --time-limit and "
-                 "--exposure may change. --output may name the same file: it is replaced atomically (docs/resume.md)");
+                 "--exposure may change. --output may name the same file: it is replaced atomically (docs/resume.md). "
+                 "An animation: a frame pattern, each frame continued from its own file (docs/animation.md)");
   c->add_option("-t,--threads", a.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
   c->add_flag("-q,--quiet", a.quiet, "No progress bar and no summary");
   c->add_flag("--stats", a.stats,
