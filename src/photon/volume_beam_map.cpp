@@ -81,8 +81,27 @@ VolumeBeamMap VolumeBeamMap::build(PhotonStore& store, const BeamBuildOptions& o
       }
     });
   }
+  if (opt.kind != BeamBuildOptions::Kind::Fixed && (opt.radiusScale != 1.0f || opt.windowScale != 1.0f))
+    m.scaleKernels(radius, opt.radiusScale, opt.windowScale);
   m.setRadii(radius);
   return m;
+}
+
+// A progressive pass's shrink of every photon's own kernel (header,
+// BeamBuildOptions::radiusScale): the disc-window volume r^2 (2w + 1) is
+// scaled by rs^2 ws exactly, whatever the rounding of w to whole bins.
+void VolumeBeamMap::scaleKernels(std::vector<float>& r, float rs, float ws) {
+  const float wholeShutter = rs * std::sqrt(ws);
+  for (size_t i = 0; i < r.size(); ++i) {
+    if (windowCode_[i] == kWholeShutter) {
+      r[i] *= wholeShutter;
+      continue;
+    }
+    const double hb = (double(windowCode_[i]) + 0.5) * double(ws);  // half-width in bins
+    const long w = std::min(long(kMaxWindowCode), std::max(0L, std::lround(hb - 0.5)));
+    windowCode_[i] = uint8_t(w);
+    r[i] = float(double(r[i]) * rs * std::sqrt(2.0 * hb / (2.0 * double(w) + 1.0)));
+  }
 }
 
 // Radius codes (rounded up; header), their tables, and the subtree bounds.

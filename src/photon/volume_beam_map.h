@@ -39,7 +39,9 @@
 //    such wide windows moved light from the ends to the middle (measured:
 //    0.70 of the truth at t = 0.01, 1.20 at t = 0.5 on a uniform set).
 //  * standard: k nearest in space, every photon the whole shutter.
-//  * fixed (progressive passes): every photon the same r and w.
+//  * progressive passes: time or standard as above, each photon's r and w
+//    then scaled by the pass's schedule (radiusScale, windowScale);
+//  * fixed: every photon the same r and w.
 //
 // Queries: crossing() walks the tree depth-first with an explicit stack of
 // (node, cell) on a per-thread BeamQuery (no allocation, no virtual call per
@@ -75,6 +77,12 @@ struct BeamBuildOptions {
   // Time: fewest photons kept in time (estimate::kMinTimePhotons; photon/
   // does not include estimate/, a test checks they agree).
   int minTimePhotons = 8;
+  // Time, Standard (progressive passes): each photon's own k-NN kernel
+  // shrunk by the pass's schedule: r *= radiusScale, the window's half-width
+  // (w + 1/2 bins) *= windowScale, rounded to whole bins with r corrected so
+  // that r^2 (2w + 1) keeps the scaled product; a whole-shutter photon takes
+  // all of it in r (r *= radiusScale sqrt(windowScale)). 1, 1: the k-NN map.
+  float radiusScale = 1.0f, windowScale = 1.0f;
   float fixedRadius = 0.0f;     // Fixed: r of every photon
   int fixedWindowCode = 0;      // Fixed: w of every photon (or kWholeShutter)
 };
@@ -128,6 +136,7 @@ class VolumeBeamMap {
  private:
   static bool segmentMeetsBox(const Segment& seg, const float* inv, const float* lo, const float* hi, float grow);
   void setRadii(const std::vector<float>& r);
+  void scaleKernels(std::vector<float>& r, float radiusScale, float windowScale);
   void setBounds();
 
   KdTree tree_;

@@ -140,10 +140,8 @@ float mainAlpha(const RenderOptions& opt) {
 // Standard, render/photon_map.h) as the pilot: the medians of their disc
 // radii and half windows (estimate::pilotKernel) are pass 1's kernel, kept
 // in state.pilot.maps[Volume] (radius, halfWindow; spatialRadius = radius).
-// Every pass's map, pass 0's included (rebuilt), is then a Fixed beam map:
-//   time-dependent: estimate::beamKernelForPass (disc x window, d = 3, the
-//     main alpha), r^2 h following the schedule in whole time bins;
-//   otherwise: the whole shutter, the radius by kernelScale(pass, alpha, 2).
+// They are reported and kept for resume; the passes' maps use each photon's
+// own k-NN kernel, shrunk (volumePassBeam).
 estimate::MapKernel volumePilotKernel(const PhotonMap& map, const Scene& scene, const RenderOptions& opt,
                                       bool timeDependent) {
   estimate::MapKernel k = pilotKernel(nullptr, scene, opt, timeDependent);  // the defaults of an empty map
@@ -155,34 +153,31 @@ estimate::MapKernel volumePilotKernel(const PhotonMap& map, const Scene& scene, 
   return k;
 }
 
-photon::BeamBuildOptions volumePassBeam(const ProgressiveMapPilot& pilot, const Scene& scene, const RenderOptions& opt,
-                                        int pass, bool timeDependent) {
-  photon::BeamBuildOptions b;
-  b.kind = photon::BeamBuildOptions::Kind::Fixed;
+// The pass's beam map: the render's own k-NN kernels on the pass's fresh
+// photons (each photon's r and w from its neighbours, the fixed-budget beam
+// kernel of Jarosz et al.), shrunk by the schedule (docs/media-estimates.md
+// "Progressive passes"): time-dependent, r and h each by kernelScale(pass,
+// alpha, 3), so r^2 h follows V_{j+1}/V_1; otherwise the whole shutter and r
+// by kernelScale(pass, alpha, 2). The pilot's medians (state) only report.
+photon::BeamBuildOptions volumePassBeam(photon::BeamBuildOptions b, const RenderOptions& opt, int pass,
+                                        bool timeDependent) {
   const double alpha = mainAlpha(opt);
   if (timeDependent) {
-    const float binWidth = float(shutterOf(scene, opt) / photon::kTimeBins);
-    estimate::BeamPassKernel k = estimate::beamKernelForPass(
-        estimate::VolumeKernel{float(pilot.radius), float(pilot.halfWindow)}, pass, binWidth, float(alpha));
-    b.fixedRadius = k.radius;
-    b.fixedWindowCode = k.windowCode;
+    b.radiusScale = b.windowScale = float(kernelScale(pass, alpha, 3));
   } else {
-    b.fixedRadius = float(pilot.radius * kernelScale(pass, alpha, 2));
-    b.fixedWindowCode = photon::kWholeShutter;
+    b.radiusScale = float(kernelScale(pass, alpha, 2));
+    b.windowScale = 1.0f;
   }
   return b;
 }
 
-// Pass 0: the volume pilot into the state, then pass 0's map rebuilt with
-// its own fixed kernel, as every later pass's. Returns the rebuild's seconds.
+// Pass 0: the volume pilot into the state. Pass 0's map is already its own
+// pass kernel (the schedule's scale is 1 at pass 0).
 double takeVolumePilot(ProgressiveState& state, PhotonMap& volume, const Scene& scene, const RenderOptions& opt,
-                       int pass, bool timeDependent) {
+                       bool timeDependent) {
   ProgressiveMapPilot& pilot = state.pilot.maps[MapKind::Volume];
   storeKernel(pilot, volumePilotKernel(volume, scene, opt, timeDependent));
-  if (volume.beams.size() == 0) return 0.0;
-  Timer rebuild;
-  volume.beams = photon::VolumeBeamMap::build(volume.store, volumePassBeam(pilot, scene, opt, pass, timeDependent));
-  return rebuild.seconds();
+  return 0.0;
 }
 
 template <class Integrator>
@@ -369,8 +364,8 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
     settings[kind].pass.firstPath = uint64_t(pass) * paths;
   }
   const bool timeDependent = renderMethodTraits(opt.method).timeDependentEstimate && scene.hasMotion;
-  if (state.pilot.done)  // the volume map's pass kernel (pass 0 has its pilot first: below)
-    settings[MapKind::Volume].beam = volumePassBeam(state.pilot.maps[MapKind::Volume], scene, opt, pass, timeDependent);
+  // The volume map's pass kernel: its own k-NN, shrunk by the schedule.
+  settings[MapKind::Volume].beam = volumePassBeam(settings[MapKind::Volume].beam, opt, pass, timeDependent);
   PhotonMaps maps = buildPhotonMaps(scene, settings, progress);
   double photonSeconds = 0;
   for (MapKind kind : kAllMapKinds) {
@@ -384,7 +379,7 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
   if (!state.pilot.done) {
     for (MapKind kind : kAllMapKinds)
       if (kind != MapKind::Volume) storeKernel(state.pilot.maps[kind], pilotKernel(maps[kind], scene, opt, timeDependent));
-    photonSeconds += takeVolumePilot(state, *maps.maps[MapKind::Volume], scene, opt, pass, timeDependent);
+    photonSeconds += takeVolumePilot(state, *maps.maps[MapKind::Volume], scene, opt, timeDependent);
     state.pilot.done = true;
     if (afterPilot) afterPilot();
   }
