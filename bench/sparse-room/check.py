@@ -2,7 +2,7 @@
 # bench/sparse-room/check.py — issue 24's two scene checks against path-traced
 # references (minutes, not a CTest; docs/photon-map.md "Few photons").
 #
-#   check.py TDPM OUT [--part sparse|room|all] [--seeds 1 2 3 4] [--res 160x120]
+#   check.py TDPM OUT [--part sparse|room|all] [--seeds 1 ... 12] [--res 160x120]
 #            [--extra "--gather 4 ..."]
 #
 # sparse: scenes/sparse-room.json, `-m time` and `-m time --search 4d` at the
@@ -16,8 +16,11 @@
 #   16-spp render moves by a few percent with the seed, in every method alike,
 #   from the rows holding the lamp (how many of a pixel's samples land on it),
 #   so the mean is also given without the lamp's band of rows
-#   [0.23 h, 0.35 h), the blocks holding those rows are judged apart (printed,
-#   not bounded), and the bounds apply to the seed means.
+#   [0.23 h, 0.35 h) and the bounds apply to the seed means. The blocks
+#   holding those rows are bounded only over 12 seeds or more: one seed of a
+#   16-spp path trace puts them anywhere in 0.93-1.11 of the reference, and
+#   3 seeds left `time` at 0.976 (stop 31) while 40 seeds of pathtrace and
+#   12 of `time` put every such block within 1.4% (stop 33).
 # room: scenes/static-room.json with tall_block moving x-0.4 -> x+0.4 over
 #   the shutter, the global map seen directly (`--global-direct --gather 0
 #   --photons 0`), 80x60, 8 spp, `time` and `standard` at 2,000, 20,000 and
@@ -127,6 +130,10 @@ def sparse_part(a, tdpm, out):
               "(of those holding lamp rows %.4f), salt %.4f%%, relMSE %.4f = %.2fx pathtrace's at equal time"
               % (label, n, mean, band, worst_mean, worst_lamp, 100 * salt, rel, rel / ptrel), flush=True)
         ok = ok and abs(mean - 1) <= 0.02 and abs(worst_mean - 1) <= 0.02 and salt <= 0.0005 and rel <= 1.5 * ptrel
+        if n >= 12:
+            ok = ok and abs(worst_lamp - 1) <= 0.02
+        else:
+            print("%-8s blocks holding the lamp rows: not bounded with fewer than 12 seeds" % label, flush=True)
     return ok
 
 
@@ -174,7 +181,7 @@ def main():
     p.add_argument("tdpm")
     p.add_argument("out")
     p.add_argument("--part", choices=("sparse", "room", "all"), default="all")
-    p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3, 4])
+    p.add_argument("--seeds", type=int, nargs="+", default=list(range(1, 13)))
     p.add_argument("--res", default="160x120")
     p.add_argument("--extra", default="")
     a = p.parse_args()
