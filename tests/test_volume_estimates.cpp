@@ -211,6 +211,52 @@ TEST_CASE("volume beam map: <= 24 bytes a photon with its tree, radius and time 
   CHECK(pilot.halfWindow < 0.3f);
 }
 
+// A progressive pass's shrink (BeamBuildOptions::radiusScale/windowScale,
+// render/progressive.cpp volumePassBeam): every photon's own disc x window
+// volume r^2 (2w + 1) is the k-NN map's times rs^2 ws, up to the radius
+// codes' rounding (each r rounds up by at most 4.45%, so r^2 within 1.0445^2),
+// and the windows really narrow; the Standard map's whole-shutter photons
+// take r x rs. This is what tells the passes' shrink from none (the render
+// test in test_media_progressive.cpp cannot at 8 passes).
+TEST_CASE("volume beam map: a pass's scale shrinks every photon's own disc x window volume by rs^2 ws") {
+  const float rs = 0.7f, ws = 0.6f;
+  for (auto kind : {BeamBuildOptions::Kind::Time, BeamBuildOptions::Kind::Standard}) {
+    PhotonStore a = boxPhotons(20000, 6, Vec3f(0.0f), [](Rng& r) { return r.uniform(); }), b = a;
+    BeamBuildOptions bo;
+    bo.kind = kind;
+    VolumeBeamMap m1 = VolumeBeamMap::build(a, bo);
+    bo.radiusScale = rs;
+    bo.windowScale = kind == BeamBuildOptions::Kind::Time ? ws : 1.0f;
+    VolumeBeamMap m2 = VolumeBeamMap::build(b, bo);
+    REQUIRE(m1.size() == m2.size());
+    const double want = kind == BeamBuildOptions::Kind::Time ? double(rs) * rs * ws : double(rs) * rs;
+    double sumRatio = 0.0, w1 = 0.0, w2 = 0.0;
+    int off = 0;
+    for (size_t i = 0; i < m1.size(); ++i) {
+      REQUIRE(a.position(i).x == b.position(i).x);  // the same photon order
+      auto vol = [](const VolumeBeamMap& m, size_t j) {
+        const double r = m.radius(j);
+        return m.windowCode(j) == photon::kWholeShutter ? r * r : r * r * (2.0 * m.windowCode(j) + 1.0);
+      };
+      const double ratio = vol(m2, i) / vol(m1, i) / want;
+      sumRatio += ratio;
+      off += int(ratio < 1.0 / (1.0445 * 1.0445) || ratio > 1.0445 * 1.0445);
+      if (kind == BeamBuildOptions::Kind::Time) {
+        CHECK(m1.windowCode(i) != photon::kWholeShutter);
+        w1 += m1.windowCode(i) + 0.5;
+        w2 += m2.windowCode(i) + 0.5;
+      } else {
+        CHECK(m2.windowCode(i) == photon::kWholeShutter);
+      }
+    }
+    MESSAGE("mean volume ratio over the wanted " << sumRatio / double(m1.size()) << ", mean half-width bins " << w1 / m1.size()
+                                                 << " -> " << w2 / m2.size());
+    CHECK(off == 0);
+    CHECK(std::fabs(sumRatio / double(m1.size()) - 1.0) < 0.03);
+    if (kind == BeamBuildOptions::Kind::Time) CHECK(w2 < 0.7 * w1);  // ws = 0.6 of the half-widths, rounded
+  }
+}
+
 TEST_CASE("beam estimate: a photon's window is 2w + 1 whole bins, half-open, reflected at the shutter ends") {
   // One photon per map, all with w = 2 (bins [q - 2, q + 2]); a segment
   // through it; the estimate is E p T / (pi r^2) x weight / binWidth.
