@@ -31,15 +31,7 @@ namespace {
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
-// A 2 x 2 m quad seen from above (image x along world x, u along x), under
-// a directional light from the side; `material` is the JSON of material "m",
-// `textures` the textures block's members.
-std::string plane(const std::string& textures, const std::string& materials) {
-  return R"({"camera": {"position": [0, 3, 0], "target": [0, 0, 0], "up": [0, 0, -1], "fov": 30, "resolution": [16, 16]},
-    "textures": {)" + textures + R"(}, "materials": {)" + materials + R"(},
-    "objects": [{"shape": {"type": "quad", "size": [2, 2]}, "material": "m"}],
-    "lights": [{"type": "directional", "direction": [-0.3, -1, 0.2], "irradiance": [3, 3, 3]}]})";
-}
+using test::texturedPlane;  // tests/texture_checks.h
 
 // The material that the BSDF sees straight below (x, z), looking down.
 Material shadedBelow(const Scene& s, float x, float z) {
@@ -64,7 +56,7 @@ const char* kCheckers = R"("eta": {"type": "checkerboard", "uscale": 2, "tex1": 
 TEST_CASE("textured conductor eta and k: each half renders as the constant conductor; values per hit") {
   std::string dir = test::makeTempDir();
   auto conductor = [&](const std::string& eta, const std::string& k) {
-    return scene::parseScene(plane(kCheckers, R"("m": {"type": "conductor", "roughness": 0.3, "eta": )" + eta +
+    return scene::parseScene(texturedPlane(kCheckers, R"("m": {"type": "conductor", "roughness": 0.3, "eta": )" + eta +
                                                   R"(, "k": )" + k + "}"),
                              dir + "/s.json");
   };
@@ -85,7 +77,7 @@ TEST_CASE("textured conductor eta and k: each half renders as the constant condu
               conductor("[0.2, 0.9, 1.1]", "[1.0, 2.0, 3.0]"));
   // A texture value of 0 for eta (a division by zero in the Fresnel term): kept at 1e-3.
   scene::SceneDescription zero = scene::parseScene(
-      plane(R"("z": {"type": "constant", "value": [0, 0.5, 0.5]}, "c": {"type": "checkerboard", "tex1": "z", "tex2": [1, 1, 1]})",
+      texturedPlane(R"("z": {"type": "constant", "value": [0, 0.5, 0.5]}, "c": {"type": "checkerboard", "tex1": "z", "tex2": [1, 1, 1]})",
             R"("m": {"type": "conductor", "eta": "c", "k": [1, 1, 1]})"),
       dir + "/z.json");
   CHECK(shadedBelow(*Scene::build(zero), -0.5f, 0.1f).eta.r == 1e-3f);
@@ -95,7 +87,7 @@ TEST_CASE("textured conductor eta and k: each half renders as the constant condu
 TEST_CASE("textured coated conductor: reflectance and eta per hit relative to the coating; each half as the constant one") {
   std::string dir = test::makeTempDir();
   auto coated = [&](const std::string& ior) {
-    return scene::parseScene(plane(kCheckers, R"("m": {"type": "coatedconductor", "roughness": 0.2, "ior": 1.5, )" + ior + "}"),
+    return scene::parseScene(texturedPlane(kCheckers, R"("m": {"type": "coatedconductor", "roughness": 0.2, "ior": 1.5, )" + ior + "}"),
                              dir + "/s.json");
   };
   scene::SceneDescription t = coated(R"("color": "refl")");
@@ -114,7 +106,7 @@ TEST_CASE("textured mix amount: the choice per hit follows the texture there; ea
   std::string dir = test::makeTempDir();
   const std::string parts = R"("red": {"type": "diffuse", "color": [0.8, 0.1, 0.1]}, "blue": {"type": "diffuse", "color": [0.1, 0.2, 0.8]}, )";
   auto mix = [&](const std::string& amount, const std::string& textures = "") {
-    return scene::parseScene(plane(std::string(kCheckers) + textures, parts + R"("m": {"type": "mix", "materials": ["red", "blue"], "amount": )" +
+    return scene::parseScene(texturedPlane(std::string(kCheckers) + textures, parts + R"("m": {"type": "mix", "materials": ["red", "blue"], "amount": )" +
                                                              amount + "}"),
                              dir + "/s.json");
   };
@@ -147,7 +139,7 @@ TEST_CASE("textured mix amount: photon classification from the components, whate
   std::string dir = test::makeTempDir();
   auto build = [&](const std::string& b) {
     return Scene::build(scene::parseScene(
-        plane(kCheckers, R"("d": {"type": "diffuse"}, "b": )" + b + R"(, "m": {"type": "mix", "materials": ["d", "b"], "amount": "amt"})"),
+        texturedPlane(kCheckers, R"("d": {"type": "diffuse"}, "b": )" + b + R"(, "m": {"type": "mix", "materials": ["d", "b"], "amount": "amt"})"),
         dir + "/s.json"));
   };
   {  // A mirror component: a caustic target of both maps.
@@ -265,7 +257,7 @@ AttributeEnd
 TEST_CASE("textured eta, k, amount: bad input gets located errors") {
   std::string dir = test::makeTempDir();
   auto json = [&](const std::string& material) {
-    return test::errorMessageOf([&] { scene::parseScene(plane(kCheckers, R"("m": )" + material), dir + "/s.json"); });
+    return test::errorMessageOf([&] { scene::parseScene(texturedPlane(kCheckers, R"("m": )" + material), dir + "/s.json"); });
   };
   CHECK(contains(json(R"({"type": "conductor", "eta": "amt", "k": [1, 1, 1]})"),
                  "materials.m.eta: texture \"amt\" is a float texture, but a spectrum (RGB) one is expected here"));
@@ -312,7 +304,7 @@ TEST_CASE("textured ior (rough dielectric, uber; pbrt-v3 glass and uber eta): ea
   const std::string iors = R"(, "ior": {"type": "checkerboard", "float": true, "uscale": 2, "tex1": 1.2, "tex2": 2.0},
     "low": {"type": "checkerboard", "float": true, "tex1": 0.9, "tex2": 1.5})";
   auto material = [&](const std::string& m) {
-    return scene::parseScene(plane(std::string(kCheckers) + iors, R"("m": )" + m), dir + "/s.json");
+    return scene::parseScene(texturedPlane(std::string(kCheckers) + iors, R"("m": )" + m), dir + "/s.json");
   };
   scene::SceneDescription t = material(R"({"type": "dielectric", "roughness": 0.3, "ior": "ior"})");
   auto s = Scene::build(t);

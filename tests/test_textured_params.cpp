@@ -33,14 +33,7 @@ namespace {
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
-// A 2 x 2 m quad seen from above (image x along world x, u along x), under
-// a directional light from the side (as tests/test_textured_materials.cpp).
-std::string plane(const std::string& textures, const std::string& materials) {
-  return R"({"camera": {"position": [0, 3, 0], "target": [0, 0, 0], "up": [0, 0, -1], "fov": 30, "resolution": [16, 16]},
-    "textures": {)" + textures + R"(}, "materials": {)" + materials + R"(},
-    "objects": [{"shape": {"type": "quad", "size": [2, 2]}, "material": "m"}],
-    "lights": [{"type": "directional", "direction": [-0.3, -1, 0.2], "irradiance": [3, 3, 3]}]})";
-}
+using test::texturedPlane;  // tests/texture_checks.h
 
 const char* kTextures = R"("sig": {"type": "checkerboard", "float": true, "uscale": 2, "tex1": 0, "tex2": 25},
     "sig20": {"type": "constant", "float": true, "value": 20},
@@ -52,7 +45,7 @@ const char* kTextures = R"("sig": {"type": "checkerboard", "float": true, "uscal
 const char* kParts = R"("red": {"type": "diffuse", "color": [0.8, 0.1, 0.1]}, "blue": {"type": "diffuse", "color": [0.1, 0.2, 0.8]}, )";
 
 scene::SceneDescription jsonScene(const std::string& material, const std::string& dir) {
-  return scene::parseScene(plane(kTextures, std::string(kParts) + R"("m": )" + material), dir + "/s.json");
+  return scene::parseScene(texturedPlane(kTextures, std::string(kParts) + R"("m": )" + material), dir + "/s.json");
 }
 
 RenderOptions pathOptions(int spp = 4, uint64_t seed = 5) { return test::smallRenderOptions(RenderMethod::PathTrace, spp, 3, seed); }
@@ -371,7 +364,7 @@ TEST_CASE("textured sigma, thickness, RGB amount: bad input gets located errors 
                  "materials.m.amount: amount must be in [0, 1] in every channel"));
   // A thickness texture reaching below 0 (no JSON texture can: a description made in code): refused when built.
   scene::SceneDescription neg = scene::parseScene(
-      plane(R"("t": {"type": "checkerboard", "float": true, "tex1": 0.1, "tex2": 0.5})", R"("m": {"type": "coateddiffuse", "thickness": "t"})"),
+      texturedPlane(R"("t": {"type": "checkerboard", "float": true, "tex1": 0.1, "tex2": 0.5})", R"("m": {"type": "coateddiffuse", "thickness": "t"})"),
       dir + "/n.json");
   REQUIRE(neg.textures.size() == 1);
   neg.textures[0].a.value = Rgb(-0.1f);

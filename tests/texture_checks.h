@@ -1,5 +1,5 @@
 // tests/texture_checks.h — the checks the textured-material and
-// textured-parameter tests share: a textured 16-pixel-wide plane's halves
+// textured-parameter tests share: the textured plane's scene (texturedPlane), a textured 16-pixel-wide plane's halves
 // render exactly as two constant scenes (checkHalves), a pbrt text imported
 // (importText), and the JSON `tdpm convert` writes reads back to the same
 // JSON and renders the same, non-black pixels (checkConvert).
@@ -18,6 +18,17 @@
 #include "scene/parse.h"
 
 namespace tdpm::test {
+
+// A 2 x 2 m quad seen from above (image x along world x, u along x), under
+// a directional light from the side: the JSON scene whose textures block
+// holds `textures` and materials block `materials` (material "m" is the
+// quad's).
+inline std::string texturedPlane(const std::string& textures, const std::string& materials) {
+  return R"({"camera": {"position": [0, 3, 0], "target": [0, 0, 0], "up": [0, 0, -1], "fov": 30, "resolution": [16, 16]},
+    "textures": {)" + textures + R"(}, "materials": {)" + materials + R"(},
+    "objects": [{"shape": {"type": "quad", "size": [2, 2]}, "material": "m"}],
+    "lights": [{"type": "directional", "direction": [-0.3, -1, 0.2], "irradiance": [3, 3, 3]}]})";
+}
 
 // The textured scene's left six columns are the pixels of scene a, its
 // right six those of scene b (the seam's columns, which the pixel filter
