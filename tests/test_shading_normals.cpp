@@ -20,6 +20,7 @@
 #include "error_capture.h"
 #include "image/pfm.h"
 #include "import/pbrt_import.h"
+#include "normal_checks.h"
 #include "render_fixtures.h"
 #include "scene/json_writer.h"
 #include "scene/parse.h"
@@ -30,10 +31,7 @@ using namespace tdpm;
 namespace {
 
 RenderOptions options(RenderMethod m, int spp, int maxDepth, uint64_t seed) {
-  RenderOptions o = test::smallRenderOptions(m, spp, maxDepth, seed);
-  o.globalPhotons = 20000;
-  o.causticPhotons = 20000;
-  return o;
+  return test::normalTestOptions(m, spp, maxDepth, seed);
 }
 
 // Camera straight down on a 2 x 2 quad (normal +y; u along +x over 2 m,
@@ -167,14 +165,7 @@ TEST_CASE("no light leaks through a bumped surface: light from below the geometr
   Hit hit;
   REQUIRE(s->intersect({0, 1, 0}, {0, -1, 0}, 10, 0, hit));
   Vec3f wi = normalize(Vec3f(-1, -0.3f, 0));
-  REQUIRE(dot(s->shadingNormal(s->materials[0], hit), wi) > 0);  // the shading normal alone would let it in
-  std::optional<Material> scratch;
-  ShadingContext c = s->shadingContext(s->materials[0], hit, {0, 1, 0}, scratch);
-  CHECK(c.shaded);
-  CHECK(bsdfEval(c, wi).isBlack());
-  CHECK(bsdfPdf(c, wi) == 0.0f);
-  for (RenderMethod m : {RenderMethod::PathTrace, RenderMethod::Time})
-    CHECK(test::imageSum(test::renderOnce(d, options(m, 4, 3, 5))) == 0.0);
+  test::checkLightFromBelowStaysOut(d, *s, hit, wi);
   std::filesystem::remove_all(dir);
 }
 
