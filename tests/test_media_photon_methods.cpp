@@ -109,6 +109,21 @@ MeanError overRuns(const std::vector<double>& v) {
   return m;
 }
 
+// Single scattering along the camera's axis (from the origin along +z) by
+// the beam estimate of `method`: 8 maps of 40k volume photons, seeds 1-8.
+MeanError singleScatteringOnAxis(const Scene& s, RenderMethod method) {
+  std::vector<double> runs;
+  for (uint64_t seed = 1; seed <= 8; ++seed) {
+    PhotonMaps maps = volumeMaps(s, method, 40000, seed, 0);
+    REQUIRE(maps[MapKind::Volume]->beams.size() > 0);
+    PhotonIntegrator integ(s, maps.view(), eyeSettings(method == RenderMethod::Time));
+    PhotonIntegrator::ThreadState ts;
+    Rng rng(seed);
+    runs.push_back(integ.radiance({0, 0, 0}, {0, 0, 1}, 0.5f, rng, ts).g);
+  }
+  return overRuns(runs);
+}
+
 }  // namespace
 
 TEST_CASE("media photon methods: the airlight integral by the beam estimate of time and standard") {
@@ -120,16 +135,7 @@ TEST_CASE("media photon methods: the airlight integral by the beam estimate of t
   REQUIRE(expected == doctest::Approx(direct).epsilon(1e-3));
   auto scene = Scene::build(airlightScene(I, sa, ss, x0, h, D));
   for (RenderMethod method : {RenderMethod::Time, RenderMethod::Standard}) {
-    std::vector<double> runs;
-    for (uint64_t seed = 1; seed <= 8; ++seed) {
-      PhotonMaps maps = volumeMaps(*scene, method, 40000, seed, 0);
-      REQUIRE(maps[MapKind::Volume]->beams.size() > 0);
-      PhotonIntegrator integ(*scene, maps.view(), eyeSettings(method == RenderMethod::Time));
-      PhotonIntegrator::ThreadState ts;
-      Rng rng(seed);
-      runs.push_back(integ.radiance({0, 0, 0}, {0, 0, 1}, 0.5f, rng, ts).g);
-    }
-    MeanError m = overRuns(runs);
+    MeanError m = singleScatteringOnAxis(*scene, method);
     INFO("method " << std::string(renderMethodName(method)) << ": " << m.mean << " +- " << m.error << ", expected " << expected);
     CHECK(std::fabs(m.mean - expected) < 4 * m.error + 0.03 * expected);
     CHECK(m.error < 0.05 * expected);
@@ -146,42 +152,27 @@ TEST_CASE("media photon methods: the airlight integral by the beam estimate of t
 TEST_CASE("media photon methods: a small sphere light inside a fog box seen from outside gives the airlight") {
   const float I = 10, sa = 0.05f, ss = 0.25f, x0 = 2.5f, h = 0.7f, a = 1, D = 5;
   const double expected = airlight(I, ss, sa + ss, x0 - a, h, D - a);
-  auto d = test::emptyScene(1, 1);
-  d.camera.position = {0, 0, 0};
-  d.camera.target = {0, 0, 1};
-  d.camera.fovDegrees = 0.5f;
-  d.materials.push_back(test::diffuse(Rgb(0.0f)));
+  // The airlight scene (camera, black wall at z = D), its fog only in a box
+  // from z = a to a + 5 and its light a sphere of radius 0.02 in the fog.
+  auto d = airlightScene(I, sa, ss, x0, h, D);
+  d.exteriorMedium = d.camera.medium = -1;
   scene::MaterialDesc none;
   none.type = scene::MaterialDesc::Type::Interface;
   d.materials.push_back(none);
-  d.objects.push_back(test::box({8, 8, 0.01f}, {0, 0, D + 0.005f}, 0));  // the black wall, inside the box
-  auto fogBox = test::box({8, 8, 5}, {0, 0, a + 2.5f}, 1);            // z from a to a + 5
+  auto fogBox = test::box({8, 8, 5}, {0, 0, a + 2.5f}, 1);
   fogBox.media.present = true;
   fogBox.media.inside = 0;
   d.objects.push_back(fogBox);
-  d.media.push_back(fog(Rgb(sa), Rgb(ss)));
-  scene::LightDesc l;
+  scene::LightDesc& l = d.lights[0];
   l.type = scene::LightDesc::Type::Area;
   l.areaShape = scene::LightDesc::AreaShape::Sphere;
   l.radius = 0.02f;
   l.placement.translate = {h, 0, x0};
-  l.power = Rgb(4 * kPi * I);
-  l.medium = 0;
-  d.lights.push_back(l);
   auto scene = Scene::build(d);
   REQUIRE(scene->hasMedia());
   REQUIRE(scene->cameraMedium == -1);
   for (RenderMethod method : {RenderMethod::Time, RenderMethod::Standard}) {
-    std::vector<double> runs;
-    for (uint64_t seed = 1; seed <= 8; ++seed) {
-      PhotonMaps maps = volumeMaps(*scene, method, 40000, seed, 0);
-      REQUIRE(maps[MapKind::Volume]->beams.size() > 0);
-      PhotonIntegrator integ(*scene, maps.view(), eyeSettings(method == RenderMethod::Time));
-      PhotonIntegrator::ThreadState ts;
-      Rng rng(seed);
-      runs.push_back(integ.radiance({0, 0, 0}, {0, 0, 1}, 0.5f, rng, ts).g);
-    }
-    MeanError m = overRuns(runs);
+    MeanError m = singleScatteringOnAxis(*scene, method);
     INFO("method " << std::string(renderMethodName(method)) << ": " << m.mean << " +- " << m.error << ", expected " << expected);
     CHECK(std::fabs(m.mean - expected) < 4 * m.error + 0.03 * expected);
     CHECK(m.error < 0.05 * expected);
