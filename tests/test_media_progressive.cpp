@@ -5,7 +5,8 @@
 // shutter on shrinking discs) and one with a light and a wall moving (the
 // pass's time windows): against volumetric pathtrace, the error over seeds
 // after 8 passes below that after 2 and the mean's bias falling (moving),
-// the mean within 6% + 4 standard errors after 8 (both; see the case);
+// the mean within 2% + 4 standard errors after 8 (both; see the case)
+// against a reference of 16 path-traced seeds;
 // 4 passes equal 2 + 2 continued and the same on one thread; and
 // through the CLI, a render resumed from its EXR equals the uninterrupted one.
 #include <doctest/doctest.h>
@@ -60,6 +61,34 @@ scene::SceneDescription fogScene(bool moving) {
   return d;
 }
 
+struct MeanError {
+  double mean = 0, error = 0;
+};
+
+// The volumetric path trace of the one pixel, averaged over 32 seeds of
+// 40,000 samples (2 s). One render is not a reference here: next-event
+// estimation at a path's second medium vertex, drawn anywhere near the
+// point light, carries I / d^2, whose tail P(V > v) ~ v^(-3/2) has no
+// variance, so a render now and then lands far above the rest (still scene:
+// seed 3 gave 0.575 against 0.548 +- 0.003 over seeds 1-16 and
+// 0.5481 +- 0.0012 over 64 seeds of 100,000; moving: seed 1 gave 0.829
+// against 0.64-0.71 for seeds 2-16; docs/media.md "Progressive passes in media").
+MeanError pathtraceReference(const Scene& s) {
+  const int seeds = 32;
+  std::vector<double> v;
+  RenderStats st;
+  for (int seed = 1; seed <= seeds; ++seed)
+    v.push_back(render(s, test::smallRenderOptions(RenderMethod::PathTrace, 40000, 8, uint64_t(seed)), Progress{}, st)
+                    .color[0]
+                    .g);
+  MeanError m;
+  for (double x : v) m.mean += x / seeds;
+  double var = 0;
+  for (double x : v) var += (x - m.mean) * (x - m.mean) / (seeds - 1);
+  m.error = std::sqrt(var / seeds);
+  return m;
+}
+
 RenderOptions passOptions(uint64_t seed) {
   RenderOptions o = test::smallRenderOptions(RenderMethod::Time, 16, 8, seed);
   o.progressive = true;
@@ -81,9 +110,7 @@ TEST_CASE("media progressive: time passes converge to pathtrace, with and withou
     REQUIRE(s->hasMedia());
     REQUIRE(s->hasMotion == moving);
     RenderStats st;
-    const double ref = render(*s, test::smallRenderOptions(RenderMethod::PathTrace, 40000, 8, 3), Progress{}, st)
-                           .color[0]
-                           .g;
+    const MeanError ref = pathtraceReference(*s);
     const int seeds = 8;
     std::vector<double> at2, at8;
     for (int seed = 1; seed <= seeds; ++seed) {
@@ -96,28 +123,29 @@ TEST_CASE("media progressive: time passes converge to pathtrace, with and withou
     }
     double mse2 = 0, mse8 = 0, mean2 = 0, mean8 = 0;
     for (int i = 0; i < seeds; ++i) {
-      mse2 += (at2[size_t(i)] - ref) * (at2[size_t(i)] - ref) / seeds;
-      mse8 += (at8[size_t(i)] - ref) * (at8[size_t(i)] - ref) / seeds;
+      mse2 += (at2[size_t(i)] - ref.mean) * (at2[size_t(i)] - ref.mean) / seeds;
+      mse8 += (at8[size_t(i)] - ref.mean) * (at8[size_t(i)] - ref.mean) / seeds;
       mean2 += at2[size_t(i)] / seeds;
       mean8 += at8[size_t(i)] / seeds;
     }
     double var8 = 0;
     for (double v : at8) var8 += (v - mean8) * (v - mean8) / (seeds - 1);
     const double se8 = std::sqrt(var8 / seeds);
-    MESSAGE((moving ? "moving" : "still") << ": pathtrace " << ref << "; rms error 2 passes " << std::sqrt(mse2) / ref
-                                          << ", 8 passes " << std::sqrt(mse8) / ref << "; mean at 2 " << mean2
-                                          << ", at 8 " << mean8 << " +- " << se8);
+    MESSAGE((moving ? "moving" : "still") << ": pathtrace " << ref.mean << " +- " << ref.error << "; rms error 2 passes "
+                                          << std::sqrt(mse2) / ref.mean << ", 8 passes " << std::sqrt(mse8) / ref.mean
+                                          << "; mean at 2 " << mean2 << ", at 8 " << mean8 << " +- " << se8);
     // Each pass's beam map is its own photons' k-NN kernel, shrunk by the
-    // schedule (render/progressive.cpp volumePassBeam). Measured (8 seeds):
-    // still 4.2% low at 2 passes, 4.5% at 8 (the pilot's median disc was
-    // 30% and 17%); moving 2.0% high at 2, 0.6% at 8. The still scene's
-    // residual bias does not fall by 8 passes (open, bench/README.md).
-    // The reference's own error is ~0.5% at 40000 samples.
-    CHECK(std::fabs(mean8 - ref) < 4 * se8 + 0.06 * ref);
-    if (moving) {
-      CHECK(mse8 < 0.7 * mse2);
-      CHECK(std::fabs(mean8 - ref) < 0.75 * std::fabs(mean2 - ref));
-    }
+    // schedule (render/progressive.cpp volumePassBeam). Measured (8 seeds,
+    // against the 16-seed reference): still +0.6% at 2 passes, +0.3% at 8;
+    // moving +2.7% at 2, +1.3% at 8. The "still 4.5% low" of earlier stops was
+    // the one-seed reference's (seed 3, 0.575: +4.9% over the 16 seeds'
+    // 0.548); a bound of 2% fails against it.
+    // The moving case's bias falling from 2 to 8 passes (2.0% to 0.6% against
+    // the old one-seed reference) is below what this reference resolves (its
+    // standard error is ~1%), so only the error's fall is checked there.
+    const double bound = 4 * std::sqrt(se8 * se8 + ref.error * ref.error) + 0.02 * ref.mean;
+    CHECK(std::fabs(mean8 - ref.mean) < bound);
+    if (moving) CHECK(mse8 < 0.7 * mse2);
   }
 }
 
