@@ -6,7 +6,7 @@
 // pass's time windows): against volumetric pathtrace, the error over seeds
 // after 8 passes below that after 2 and the mean's bias falling (moving),
 // the mean within 2% + 4 standard errors after 8 (both; see the case)
-// against a reference of 16 path-traced seeds;
+// against a reference of 32 path-traced seeds;
 // 4 passes equal 2 + 2 continued and the same on one thread; and
 // through the CLI, a render resumed from its EXR equals the uninterrupted one.
 #include <doctest/doctest.h>
