@@ -39,6 +39,7 @@ struct PhotonMap {
   // shutter, for the standard estimate, while `tree` spans the frame's time
   // window (its shutter plus what the time kernel may reach).
   bool separateStandard = false;
+  size_t ownPhotons = 0;  // animations: the photons of the frame's own shutter (its stats)
   uint64_t emitted = 0;
   double traceSeconds = 0, buildSeconds = 0;
   std::string warning;  // from tracing: empty map, or fewer photons than wanted
@@ -80,6 +81,16 @@ photon::TraceSettings traceSettingsFor(const RenderOptions& opt, MapKind kind, s
 // render/renderer.cpp), or the pass's path range (render/progressive.cpp).
 PerMap<PhotonMapSettings> photonMapSettingsFor(const RenderOptions& opt, const PerMap<size_t>& wanted, uint64_t seed,
                                                bool spreadInTime, float fixedTime01);
+
+// The volume map's k-NN beam kernels from the options (render/photon_map.h
+// top): Time for a time-dependent method, else Standard; k_s, the
+// fraction, --max-dt. resolvedBeamOptions then fits them to the photons: a
+// Time kernel on a scene without motion becomes Standard, an infinite max
+// time distance maxDtFraction x shutterLength (the photons' shutter: the
+// render's, a progressive frame's, an animation frame's).
+photon::BeamBuildOptions beamOptionsFor(const RenderOptions& opt);
+photon::BeamBuildOptions resolvedBeamOptions(photon::BeamBuildOptions beam, const Scene& scene, float maxDtFraction,
+                                             float shutterLength);
 
 std::unique_ptr<PhotonMap> buildPhotonMap(const Scene& scene, const PhotonMapSettings& settings,
                                           const Progress& progress);
