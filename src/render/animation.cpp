@@ -142,13 +142,15 @@ photon::PhotonStore frameStore(const std::vector<const Segment*>& segments, cons
 // block's shared set (docs/animation.md sections 5 and 7). Surfaces: every
 // photon of the time map, re-binned on the frame's 256 bins (an integer
 // shift: same grid), and a 3D tree of its shutter's photons alone for the
-// standard estimate. Volume (scenes with media): one beam map, its kernels
-// built as a still render's (render/photon_map.h): Standard over the
-// shutter's photons alone (as the surfaces' standard store), Time over the
-// time map's photons, the store's 256 bins stretched over exactly the time
-// they cover, [c0, c1) (the map clipped to the timeline), because the beam
-// estimate treats the store's ends as the photons' ends: it reflects the
-// windows there and spreads a whole-shutter photon over all 256 bins.
+// standard estimate. Volume (scenes with media): beam maps, their kernels
+// built as a still render's (render/photon_map.h). Standard: one, over the
+// shutter's photons alone (as the surfaces' standard store). Time: one over
+// the time map's photons, the store's 256 bins stretched over exactly the
+// time they cover, [c0, c1) (the map clipped to the timeline), because the
+// beam estimate treats the store's ends as the photons' ends: it reflects
+// the windows there and spreads a whole-shutter photon over all 256 bins;
+// and a Standard one over the shutter's photons for the skip rule's
+// standard form (the shutter's average, not the pads').
 std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments, const SharedSet* shared,
                                     MapKind kind, const TimeGrid& g, int frame, const FrameMapSettings& fs) {
   const int64_t lo = g.mapLo(frame), hi = g.mapHi(frame);
@@ -156,16 +158,23 @@ std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments,
   const int64_t s0 = int64_t(frame) * g.binsPerFrame, s1 = s0 + g.shutterBins;
   const FrameStore own{s0, s1, s0, g.shutterBins, g.shutterBins};
   auto map = std::make_unique<PhotonMap>();
-  map->separateStandard = true;
+  map->ownPhotons = photonsInside(segments, shared, kind, s0, s1);
   if (kind == MapKind::Volume) {
-    if (fs.beam.kind == photon::BeamBuildOptions::Kind::Time)
-      map->store = frameStore(segments, shared, kind, g, FrameStore{lo, hi, c0, c1 - c0, c1 - c0});
-    else
+    if (fs.beam.kind != photon::BeamBuildOptions::Kind::Time) {
       map->store = frameStore(segments, shared, kind, g, own);
-    map->ownPhotons = photonsInside(segments, shared, kind, s0, s1);
+      if (!map->store.empty()) map->beams = photon::VolumeBeamMap::build(map->store, fs.beam);
+      return map;
+    }
+    map->separateStandard = true;
+    map->store = frameStore(segments, shared, kind, g, FrameStore{lo, hi, c0, c1 - c0, c1 - c0});
     if (!map->store.empty()) map->beams = photon::VolumeBeamMap::build(map->store, fs.beam);
+    map->store3 = frameStore(segments, shared, kind, g, own);
+    photon::BeamBuildOptions standard = fs.beam;
+    standard.kind = photon::BeamBuildOptions::Kind::Standard;
+    if (!map->store3.empty()) map->beams3 = photon::VolumeBeamMap::build(map->store3, standard);
     return map;
   }
+  map->separateStandard = true;
   map->store = frameStore(segments, shared, kind, g, FrameStore{lo, hi, lo, photon::kTimeBins, c1 - c0, c0 - lo, c1 - c0});
   photon::KdBuildOptions opt;
   opt.spaceTime = fs.spaceTime;
@@ -173,7 +182,6 @@ std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments,
   map->tree = photon::KdTree::build(map->store, opt);
   map->store3 = frameStore(segments, shared, kind, g, own);
   map->tree3 = photon::KdTree::build(map->store3, {});
-  map->ownPhotons = map->store3.size();
   return map;
 }
 

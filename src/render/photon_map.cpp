@@ -70,7 +70,8 @@ photon::BeamBuildOptions resolvedBeamOptions(photon::BeamBuildOptions beam, cons
 
 double PhotonMap::bytesPerPhoton() const {
   if (store.empty()) return 0.0;
-  if (beams.size() > 0) return beams.bytesPerPhoton();
+  if (beams.size() > 0)
+    return beams.bytesPerPhoton() + beams3.bytesPerPhoton() * double(store3.size()) / double(store.size());
   double bytes = double(store.bytesAllocated()) + double(store3.bytesAllocated());
   return bytes / double(store.size());
 }

@@ -14,8 +14,12 @@
 //   standard  Kind::Standard (k = ks) otherwise (static, standard,
 //             accumulation frames, a still scene);
 //   pass      Kind::Fixed with the pass's kernel (render/progressive.cpp).
-// The eye side reads maps[MapKind::Volume]->beams; it is empty (size 0)
-// when the scene has no media (no volume map traced).
+// The eye side reads maps[MapKind::Volume]->beams (volumeBeams); it is
+// empty (size 0) when the scene has no media (no volume map traced).
+// Animation frames with the Time kernel hold two (render/animation.cpp
+// frameMap): `beams` over the frame's time map, `beams3` (Standard, over
+// `store3`, the shutter's photons alone) for the skip rule's standard form,
+// as the surface maps' tree3.
 #pragma once
 #include <memory>
 #include <string>
@@ -34,7 +38,8 @@ struct PhotonMap {
   photon::KdTree tree;         // 3D, or 4D when built for the space-time search
   photon::PhotonStore store3;  // 4D maps only: a 3D-ordered copy
   photon::KdTree tree3;
-  photon::VolumeBeamMap beams;  // MapKind::Volume only: built over `store` (see the top)
+  photon::VolumeBeamMap beams;   // MapKind::Volume only: built over `store` (see the top)
+  photon::VolumeBeamMap beams3;  // animation frames' Time volume maps: the shutter's, over `store3`
   // Animations (render/animation.h): store3/tree3 hold only the frame's own
   // shutter, for the standard estimate, while `tree` spans the frame's time
   // window (its shutter plus what the time kernel may reach).
@@ -45,6 +50,11 @@ struct PhotonMap {
   std::string warning;  // from tracing: empty map, or fewer photons than wanted
 
   const photon::KdTree& spatialTree() const { return tree.spaceTime() || separateStandard ? tree3 : tree; }
+  // The volume map the beam estimate reads: its time-dependent form reads
+  // `beams`, its standard form the shutter's own where a frame keeps one.
+  const photon::VolumeBeamMap& volumeBeams(bool timeDependent) const {
+    return separateStandard && !timeDependent ? beams3 : beams;
+  }
   size_t size() const { return store.size(); }
   double bytesPerPhoton() const;
 };
