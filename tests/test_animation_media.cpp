@@ -2,8 +2,8 @@
 // (render/animation.cpp frameMap's volume beam maps): a frame of a fog
 // animation with a light moving through it against the same frame rendered
 // alone as a still with the same shutter and against the volumetric path
-// tracer of that frame (time and standard, the first, an inner and the last
-// frame, both forms of the time estimate), volume photons shared by a block
+// tracer of that frame (time and standard, the first and an inner frame,
+// both forms of the time estimate), volume photons shared by a block
 // (still light, moving occluder) against the same frame without sharing,
 // progressive frames against the frame alone in passes, and the command
 // line: a fog animation renders with time, refuses accumulation.
@@ -129,9 +129,9 @@ TEST_CASE("animation in media: a frame equals the frame alone and the volumetric
   ao.movingScale = 1;
   struct Case {
     bool timeDependent;
-    int frame;  // 0: the timeline's first (its map clipped at 0); 3: the last
+    int frame;  // 0: the timeline's first (its map clipped at 0); 2: an inner one, pads on both sides
   };
-  for (Case c : {Case{true, 0}, Case{true, 2}, Case{true, 3}, Case{false, 0}}) {
+  for (Case c : {Case{true, 0}, Case{true, 2}, Case{false, 0}}) {
     const bool timeDependent = c.timeDependent;
     const int frame = c.frame;
     const RenderMethod method = timeDependent ? RenderMethod::Time : RenderMethod::Standard;
@@ -160,7 +160,7 @@ TEST_CASE("animation in media: a frame equals the frame alone and the volumetric
   // time with a still camera reads the skip rule's standard form from the
   // Time map's shutter copy: the same photons and kernels as standard's map.
   const auto still = fogAnimation(false);
-  for (int frame : {0, 3})
+  for (int frame : {0, 3})  // the first and the last (its map clipped at the timeline's end)
     CHECK(test::sameImage(animationFrame(still, fogOptions(RenderMethod::Time, 1), frame),
                           animationFrame(still, fogOptions(RenderMethod::Standard, 1), frame)));
 }
@@ -184,13 +184,13 @@ TEST_CASE("animation in media: a block's shared volume photons keep the frame's 
     AnimationOptions shared, own;
     own.sharedScale = 0;
     size_t sharedPhotons = 0;
-    const auto withShared = overSeeds(6, [&](uint64_t seed) {
+    const auto withShared = overSeeds(4, [&](uint64_t seed) {
       AnimationStats st;
       double v = meanGreen(animationFrame(d, fogOptions(m, seed), 1, shared, &st));
       sharedPhotons = st.sharedPhotons;
       return v;
     });
-    const auto without = overSeeds(6, [&](uint64_t seed) {
+    const auto without = overSeeds(4, [&](uint64_t seed) {
       return meanGreen(animationFrame(d, fogOptions(m, seed + 100), 1, own));
     });
     INFO(std::string(renderMethodName(m)) << ": shared " << withShared.mean << " +- " << withShared.error << ", not shared "
@@ -209,12 +209,13 @@ TEST_CASE("animation in media: a progressive frame equals the frame alone in the
     auto passes = [&](uint64_t seed) {
       auto o = fogOptions(m, seed, 4);
       o.volumePhotons = 10000;
+      o.volumeK = 32;  // the fixed-budget default (progressive takes --k's)
       o.progressive = true;
       o.passes = 2;
       return o;
     };
-    const auto seq = overSeeds(4, [&](uint64_t seed) { return meanGreen(animationFrame(anim, passes(seed), 2)); });
-    const auto alone = overSeeds(4, [&](uint64_t seed) {
+    const auto seq = overSeeds(3, [&](uint64_t seed) { return meanGreen(animationFrame(anim, passes(seed), 2)); });
+    const auto alone = overSeeds(3, [&](uint64_t seed) {
       return meanGreen(test::renderOnce(fogFrameAlone(2, false), passes(seed + 100)));
     });
     INFO(std::string(renderMethodName(m)) << ": progressive frame " << seq.mean << " +- " << seq.error << ", alone " << alone.mean

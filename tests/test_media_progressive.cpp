@@ -17,6 +17,7 @@
 
 #include "cli_harness.h"
 #include "image/exr.h"
+#include "airlight_scene.h"
 #include "progressive_checks.h"
 #include "render/progressive.h"
 #include "render/renderer.h"
@@ -33,30 +34,14 @@ namespace {
 // at (h, 0, x0), fog everywhere (multiple scattering, final gather).
 scene::SceneDescription fogScene(bool moving) {
   const float I = 10, sa = 0.05f, ss = 0.25f, x0 = 2, h = 0.7f, D = 5;
-  auto d = test::emptyScene(1, 1);
-  d.camera.position = {0, 0, 0};
-  d.camera.target = {0, 0, 1};
-  d.camera.fovDegrees = 0.5f;
-  d.materials.push_back(test::diffuse(Rgb(0.5f)));
-  d.objects.push_back(test::box({100, 100, 0.01f}, {0, 0, D + 0.005f}, 0));
-  scene::MediumDesc m;
-  m.name = "fog";
-  m.sigmaA = Rgb(sa);
-  m.sigmaS = Rgb(ss);
-  d.media.push_back(m);
-  d.exteriorMedium = d.camera.medium = 0;
-  scene::LightDesc l;
-  l.type = scene::LightDesc::Type::Point;
-  l.position = {h, 0, x0};
-  l.power = Rgb(4 * kPi * I);
-  l.medium = 0;
+  auto d = test::airlightScene(I, sa, ss, x0, h, D);
+  d.materials[0] = test::diffuse(Rgb(0.5f));
   if (moving) {  // the light along the ray, the wall behind it (the moving test there)
-    l.position = {0, 0, 0};
-    l.motion = test::translation({h, 0, 0.5f}, {h, 0, 4.0f});
+    d.lights[0].position = {0, 0, 0};
+    d.lights[0].motion = test::translation({h, 0, 0.5f}, {h, 0, 4.0f});
     d.objects[0].placement.translate = {0, 0, 0};
     d.objects[0].motion = test::translation({0, 0, 2.005f}, {0, 0, 5.505f});
   }
-  d.lights.push_back(l);
   return d;
 }
 
