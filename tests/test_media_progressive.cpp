@@ -18,6 +18,7 @@
 
 #include "cli_harness.h"
 #include "image/exr.h"
+#include "airlight_scene.h"
 #include "progressive_checks.h"
 #include "render/progressive.h"
 #include "render/renderer.h"
@@ -34,36 +35,16 @@ namespace {
 // at (h, 0, x0), fog everywhere (multiple scattering, final gather).
 scene::SceneDescription fogScene(bool moving) {
   const float I = 10, sa = 0.05f, ss = 0.25f, x0 = 2, h = 0.7f, D = 5;
-  auto d = test::emptyScene(1, 1);
-  d.camera.position = {0, 0, 0};
-  d.camera.target = {0, 0, 1};
-  d.camera.fovDegrees = 0.5f;
-  d.materials.push_back(test::diffuse(Rgb(0.5f)));
-  d.objects.push_back(test::box({100, 100, 0.01f}, {0, 0, D + 0.005f}, 0));
-  scene::MediumDesc m;
-  m.name = "fog";
-  m.sigmaA = Rgb(sa);
-  m.sigmaS = Rgb(ss);
-  d.media.push_back(m);
-  d.exteriorMedium = d.camera.medium = 0;
-  scene::LightDesc l;
-  l.type = scene::LightDesc::Type::Point;
-  l.position = {h, 0, x0};
-  l.power = Rgb(4 * kPi * I);
-  l.medium = 0;
+  auto d = test::airlightScene(I, sa, ss, x0, h, D);
+  d.materials[0] = test::diffuse(Rgb(0.5f));
   if (moving) {  // the light along the ray, the wall behind it (the moving test there)
-    l.position = {0, 0, 0};
-    l.motion = test::translation({h, 0, 0.5f}, {h, 0, 4.0f});
+    d.lights[0].position = {0, 0, 0};
+    d.lights[0].motion = test::translation({h, 0, 0.5f}, {h, 0, 4.0f});
     d.objects[0].placement.translate = {0, 0, 0};
     d.objects[0].motion = test::translation({0, 0, 2.005f}, {0, 0, 5.505f});
   }
-  d.lights.push_back(l);
   return d;
 }
-
-struct MeanError {
-  double mean = 0, error = 0;
-};
 
 // The volumetric path trace of the one pixel, averaged over 32 seeds of
 // 40,000 samples (2 s). One render is not a reference here: next-event
@@ -73,7 +54,7 @@ struct MeanError {
 // seed 3 gave 0.575 against 0.548 +- 0.003 over seeds 1-16 and
 // 0.5481 +- 0.0012 over 64 seeds of 100,000; moving: seed 1 gave 0.829
 // against 0.64-0.71 for seeds 2-16; docs/media.md "Progressive passes in media").
-MeanError pathtraceReference(const Scene& s) {
+test::MeanError pathtraceReference(const Scene& s) {
   const int seeds = 32;
   std::vector<double> v;
   RenderStats st;
@@ -81,12 +62,7 @@ MeanError pathtraceReference(const Scene& s) {
     v.push_back(render(s, test::smallRenderOptions(RenderMethod::PathTrace, 40000, 8, uint64_t(seed)), Progress{}, st)
                     .color[0]
                     .g);
-  MeanError m;
-  for (double x : v) m.mean += x / seeds;
-  double var = 0;
-  for (double x : v) var += (x - m.mean) * (x - m.mean) / (seeds - 1);
-  m.error = std::sqrt(var / seeds);
-  return m;
+  return test::overRuns(v);
 }
 
 RenderOptions passOptions(uint64_t seed) {
@@ -110,7 +86,7 @@ TEST_CASE("media progressive: time passes converge to pathtrace, with and withou
     REQUIRE(s->hasMedia());
     REQUIRE(s->hasMotion == moving);
     RenderStats st;
-    const MeanError ref = pathtraceReference(*s);
+    const test::MeanError ref = pathtraceReference(*s);
     const int seeds = 8;
     std::vector<double> at2, at8;
     for (int seed = 1; seed <= seeds; ++seed) {

@@ -82,71 +82,106 @@ struct SharedSet {
 // re-encoded: rounded to nearest, zero-mean error as the store's own).
 uint32_t scaledEnergy(uint32_t rgbe, float factor) { return photon::encodeRgbe(photon::decodeRgbe(rgbe) * factor); }
 
-// The shared set's photons into frame `frame`'s two stores: over the time
-// map's covered bins [c0, c1) with energy x (c1 - c0) / (block length), and
-// into the shutter's store with energy x S / (block length), each keeping
-// its place q of 256 in the block's time (uniform and independent of where
-// it lies: the density in time of light that does not change).
-void addShared(const SharedSet& sh, MapKind kind, const TimeGrid& g, int64_t lo, int64_t c0, int64_t c1,
-               photon::PhotonStore& all, photon::PhotonStore& own) {
-  const photon::PhotonStore& st = sh.stores[kind];
-  const double block = double(sh.hi - sh.lo);
-  const float toMap = float(double(c1 - c0) / block), toShutter = float(double(g.shutterBins) / block);
-  for (size_t p = 0; p < st.size(); ++p) {
-    const int64_t q = st.timeBin(p);
-    all.addEncoded(st.xs()[p], st.ys()[p], st.zs()[p], scaledEnergy(st.energies()[p], toMap), st.directions()[p],
-                   st.flags()[p], uint8_t(c0 - lo + q * (c1 - c0) / photon::kTimeBins));
-    own.addEncoded(st.xs()[p], st.ys()[p], st.zs()[p], scaledEnergy(st.energies()[p], toShutter), st.directions()[p],
-                   st.flags()[p], uint8_t(q));
-  }
+// One of a frame's stores and where its photons go in it.
+struct FrameStore {
+  int64_t a = 0, b = 0;        // the segments inside grid bins [a, b) join it,
+  int64_t base = 0, span = 0;  // re-binned onto its 256 bins over grid bins [base, base + span)
+  // The shared set's photons: energy x sharedBins / (block length), its
+  // place q of 256 in the block's time at store bin sharedOff + q sharedSpan / 256.
+  int64_t sharedBins = 0, sharedOff = 0, sharedSpan = photon::kTimeBins;
+};
+
+// Photons of one kind of the segments inside grid bins [a, b) and of the
+// shared set.
+size_t photonsInside(const std::vector<const Segment*>& segments, const SharedSet* shared, MapKind kind, int64_t a,
+                     int64_t b) {
+  size_t n = shared ? shared->stores[kind].size() : 0;
+  for (const Segment* s : segments)
+    if (inside(s->lo, s->hi, a, b)) n += s->stores[kind].size();
+  return n;
 }
 
-// Frame i's map of one kind: every photon of the segments inside its time
-// map, re-binned on the frame's 256 bins (an integer shift: same grid), and
-// a 3D tree of its shutter's photons alone for the standard estimate.
-// With a shared set, its time-invariant photons join both (addShared).
-std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments, const SharedSet* shared,
-                                    MapKind kind, const TimeGrid& g, int frame, int64_t timelineEnd, bool spaceTime,
-                                    float kappa) {
-  const int64_t lo = g.mapLo(frame), hi = g.mapHi(frame);
-  const int64_t s0 = int64_t(frame) * g.binsPerFrame, s1 = s0 + g.shutterBins;
-  auto map = std::make_unique<PhotonMap>();
-  photon::PhotonStore all(float(double(lo) * g.binWidth), float(double(lo + photon::kTimeBins) * g.binWidth));
-  photon::PhotonStore own(float(double(s0) * g.binWidth), float(double(s1) * g.binWidth));
-  size_t nAll = 0, nOwn = 0;
-  for (const Segment* s : segments) {
-    if (!inside(s->lo, s->hi, lo, hi)) continue;
-    size_t n = s->stores[kind].size();
-    nAll += n;
-    if (inside(s->lo, s->hi, s0, s1)) nOwn += n;
+// What every frame map of a run is built with.
+struct FrameMapSettings {
+  int64_t timelineEnd = 0;  // bins
+  bool spaceTime = false;   // surfaces: the 4D tree
+  float kappa = 1.0f;
+  photon::BeamBuildOptions beam;  // volume: the beam kernels, resolved for a frame's shutter
+};
+
+// The frame's photons of one kind into one store (FrameStore). Shared
+// photons keep their place q of 256 in the block's time (uniform and
+// independent of where they lie: the density in time of light that does
+// not change), spread over the time they stand for in this store.
+photon::PhotonStore frameStore(const std::vector<const Segment*>& segments, const SharedSet* shared, MapKind kind,
+                               const TimeGrid& g, const FrameStore& f) {
+  photon::PhotonStore out(float(double(f.base) * g.binWidth), float(double(f.base + f.span) * g.binWidth));
+  out.reserve(photonsInside(segments, shared, kind, f.a, f.b));
+  if (shared) {
+    const photon::PhotonStore& st = shared->stores[kind];
+    const float factor = float(double(f.sharedBins) / double(shared->hi - shared->lo));
+    for (size_t p = 0; p < st.size(); ++p)
+      out.addEncoded(st.xs()[p], st.ys()[p], st.zs()[p], scaledEnergy(st.energies()[p], factor), st.directions()[p],
+                     st.flags()[p], uint8_t(f.sharedOff + st.timeBin(p) * f.sharedSpan / photon::kTimeBins));
   }
-  const size_t nShared = shared ? shared->stores[kind].size() : 0;
-  all.reserve(nAll + nShared);
-  own.reserve(nOwn + nShared);
-  if (shared) addShared(*shared, kind, g, lo, std::max<int64_t>(lo, 0), std::min(hi, timelineEnd), all, own);
   for (const Segment* s : segments) {
-    if (!inside(s->lo, s->hi, lo, hi)) continue;
+    if (!inside(s->lo, s->hi, f.a, f.b)) continue;
     const photon::PhotonStore& st = s->stores[kind];
-    const bool shutter = inside(s->lo, s->hi, s0, s1);
     const int64_t last = s->hi - s->lo - 1;
     for (size_t p = 0; p < st.size(); ++p) {
       // A time a rounding error past the segment's end stays in it.
-      int64_t bin = s->lo + std::min<int64_t>(st.timeBin(p), last);
-      all.addEncoded(st.xs()[p], st.ys()[p], st.zs()[p], st.energies()[p], st.directions()[p], st.flags()[p],
-                     uint8_t(bin - lo));
-      if (shutter)
-        own.addEncoded(st.xs()[p], st.ys()[p], st.zs()[p], st.energies()[p], st.directions()[p], st.flags()[p],
-                       uint8_t((bin - s0) * photon::kTimeBins / g.shutterBins));
+      const int64_t bin = s->lo + std::min<int64_t>(st.timeBin(p), last);
+      out.addEncoded(st.xs()[p], st.ys()[p], st.zs()[p], st.energies()[p], st.directions()[p], st.flags()[p],
+                     uint8_t((bin - f.base) * photon::kTimeBins / f.span));
     }
   }
-  map->store = std::move(all);
-  photon::KdBuildOptions opt;
-  opt.spaceTime = spaceTime;
-  opt.kappa = kappa;
-  map->tree = photon::KdTree::build(map->store, opt);
-  map->store3 = std::move(own);
-  map->tree3 = photon::KdTree::build(map->store3, {});
+  return out;
+}
+
+// Frame i's map of one kind, from the segments inside its time map and the
+// block's shared set (docs/animation.md sections 5 and 7). Surfaces: every
+// photon of the time map, re-binned on the frame's 256 bins (an integer
+// shift: same grid), and a 3D tree of its shutter's photons alone for the
+// standard estimate. Volume (scenes with media): beam maps, their kernels
+// built as a still render's (render/photon_map.h). Standard: one, over the
+// shutter's photons alone (as the surfaces' standard store). Time: one over
+// the time map's photons, the store's 256 bins stretched over exactly the
+// time they cover, [c0, c1) (the map clipped to the timeline), because the
+// beam estimate treats the store's ends as the photons' ends: it reflects
+// the windows there and spreads a whole-shutter photon over all 256 bins;
+// and a Standard one over the shutter's photons for the skip rule's
+// standard form (the shutter's average, not the pads').
+std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments, const SharedSet* shared,
+                                    MapKind kind, const TimeGrid& g, int frame, const FrameMapSettings& fs) {
+  const int64_t lo = g.mapLo(frame), hi = g.mapHi(frame);
+  const int64_t c0 = std::max<int64_t>(lo, 0), c1 = std::min(hi, fs.timelineEnd);
+  const int64_t s0 = int64_t(frame) * g.binsPerFrame, s1 = s0 + g.shutterBins;
+  const FrameStore own{s0, s1, s0, g.shutterBins, g.shutterBins};
+  auto map = std::make_unique<PhotonMap>();
+  map->ownPhotons = photonsInside(segments, shared, kind, s0, s1);
+  if (kind == MapKind::Volume) {
+    if (fs.beam.kind != photon::BeamBuildOptions::Kind::Time) {
+      map->store = frameStore(segments, shared, kind, g, own);
+      if (!map->store.empty()) map->beams = photon::VolumeBeamMap::build(map->store, fs.beam);
+      return map;
+    }
+    map->separateStandard = true;
+    map->store = frameStore(segments, shared, kind, g, FrameStore{lo, hi, c0, c1 - c0, c1 - c0});
+    if (!map->store.empty()) map->beams = photon::VolumeBeamMap::build(map->store, fs.beam);
+    map->store3 = frameStore(segments, shared, kind, g, own);
+    photon::BeamBuildOptions standard = fs.beam;
+    standard.kind = photon::BeamBuildOptions::Kind::Standard;
+    if (!map->store3.empty()) map->beams3 = photon::VolumeBeamMap::build(map->store3, standard);
+    return map;
+  }
   map->separateStandard = true;
+  map->store = frameStore(segments, shared, kind, g, FrameStore{lo, hi, lo, photon::kTimeBins, c1 - c0, c0 - lo, c1 - c0});
+  photon::KdBuildOptions opt;
+  opt.spaceTime = fs.spaceTime;
+  opt.kappa = fs.kappa;
+  map->tree = photon::KdTree::build(map->store, opt);
+  map->store3 = frameStore(segments, shared, kind, g, own);
+  map->tree3 = photon::KdTree::build(map->store3, {});
   return map;
 }
 
@@ -535,9 +570,13 @@ void renderTimelineFrame(const Scene& scene, const scene::AnimationDesc& anim, c
   if (photons) {
     Timer mapTimer;
     std::vector<const Segment*> segs = timeline.segments();
-    const int64_t end = int64_t(anim.frames) * grid.binsPerFrame;
+    FrameMapSettings fs;
+    fs.timelineEnd = int64_t(anim.frames) * grid.binsPerFrame;
+    fs.spaceTime = spaceTime;
+    fs.kappa = opt.kappa;
+    fs.beam = resolvedBeamOptions(beamOptionsFor(opt), scene, opt.maxDtFraction, in.shutter.length());
     for (MapKind k : kAllMapKinds) {
-      maps[k] = frameMap(segs, timeline.shared(), k, grid, frame, end, spaceTime, opt.kappa);
+      maps[k] = frameMap(segs, timeline.shared(), k, grid, frame, fs);
       in.maps[k] = maps[k].get();
       heldNow += maps[k]->store.size() + maps[k]->store3.size();
     }
@@ -548,7 +587,7 @@ void renderTimelineFrame(const Scene& scene, const scene::AnimationDesc& anim, c
   RenderStats st;
   Film film = renderFrame(scene, opt, in, framed, st);
   for (MapKind k : kAllMapKinds) {
-    if (photons) st.maps[k].stored = maps[k]->store3.size();  // the frame's own shutter
+    if (photons) st.maps[k].stored = maps[k]->ownPhotons;  // the frame's own shutter
     maps[k].reset();
   }
   sink(frame, std::move(film), st);

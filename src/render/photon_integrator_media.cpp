@@ -66,9 +66,9 @@ Rgb PhotonIntegrator::mediumSegment(Vec3f o, Vec3f d, float tEnd, int32_t medium
                                     bool withEstimate, Rgb& beta, ThreadState& ts, Rng& rng, Rng& beamRng) const {
   const media::Medium& m = scene_.media[size_t(medium)];
   Rgb L(0.0f);
-  if (withEstimate && volume_ && volume_->beams.size() > 0 && !m.sigmaS.isBlack()) {
+  if (withEstimate && volume_ && volume_->volumeBeams(timeDependent).size() > 0 && !m.sigmaS.isBlack()) {
     if (!ts.beams) ts.beams = std::make_unique<photon::BeamQuery>();
-    const photon::VolumeBeamMap& map = volume_->beams;
+    const photon::VolumeBeamMap& map = volume_->volumeBeams(timeDependent);
     photon::Segment seg{o, d, 0.0f, tEnd};
     const float t = scene_.shutter.instant() ? map.store().t0() : scene_.shutter.fromNormalized(time01);
     const estimate::HgPhase phase{m.g};

@@ -44,20 +44,34 @@ PerMap<PhotonMapSettings> photonMapSettingsFor(const RenderOptions& opt, const P
     ms.trace.spreadInTime = spreadInTime;
     ms.trace.fixedTime01 = fixedTime01;
   }
-  photon::BeamBuildOptions& beam = all[MapKind::Volume].beam;
+  all[MapKind::Volume].beam = beamOptionsFor(opt);
+  all[MapKind::Volume].maxDtFraction = opt.maxDtFraction;
+  return all;
+}
+
+photon::BeamBuildOptions beamOptionsFor(const RenderOptions& opt) {
+  photon::BeamBuildOptions beam;
   beam.kind = renderMethodTraits(opt.method).timeDependentEstimate ? photon::BeamBuildOptions::Kind::Time
                                                                    : photon::BeamBuildOptions::Kind::Standard;
   beam.ks = opt.effectiveVolumeK();
   beam.fraction = opt.estimate.fraction;
   beam.maxTimeDistance = opt.estimate.maxTimeDistance;
   beam.minTimePhotons = estimate::kMinTimePhotons;
-  all[MapKind::Volume].maxDtFraction = opt.maxDtFraction;
-  return all;
+  return beam;
+}
+
+photon::BeamBuildOptions resolvedBeamOptions(photon::BeamBuildOptions beam, const Scene& scene, float maxDtFraction,
+                                             float shutterLength) {
+  if (beam.kind == photon::BeamBuildOptions::Kind::Time && !scene.hasMotion)
+    beam.kind = photon::BeamBuildOptions::Kind::Standard;
+  if (!std::isfinite(beam.maxTimeDistance)) beam.maxTimeDistance = maxDtFraction * shutterLength;
+  return beam;
 }
 
 double PhotonMap::bytesPerPhoton() const {
   if (store.empty()) return 0.0;
-  if (beams.size() > 0) return beams.bytesPerPhoton();
+  if (beams.size() > 0)
+    return beams.bytesPerPhoton() + beams3.bytesPerPhoton() * double(store3.size()) / double(store.size());
   double bytes = double(store.bytesAllocated()) + double(store3.bytesAllocated());
   return bytes / double(store.size());
 }
@@ -76,14 +90,9 @@ std::unique_ptr<PhotonMap> buildPhotonMap(const Scene& scene, const PhotonMapSet
   opt.kappa = settings.kappa;
   opt.comm = settings.trace.comm;  // under mpirun the ranks share the build
   if (settings.trace.kind == MapKind::Volume) {
-    photon::BeamBuildOptions beam = settings.beam;
-    if (beam.kind == photon::BeamBuildOptions::Kind::Time && !scene.hasMotion)
-      beam.kind = photon::BeamBuildOptions::Kind::Standard;
-    if (!std::isfinite(beam.maxTimeDistance)) {
-      float ts = std::isfinite(settings.trace.timeOpen) ? settings.trace.timeClose - settings.trace.timeOpen
-                                                        : scene.shutter.length();
-      beam.maxTimeDistance = settings.maxDtFraction * ts;
-    }
+    const float ts = std::isfinite(settings.trace.timeOpen) ? settings.trace.timeClose - settings.trace.timeOpen
+                                                            : scene.shutter.length();
+    const photon::BeamBuildOptions beam = resolvedBeamOptions(settings.beam, scene, settings.maxDtFraction, ts);
     if (!map->store.empty()) map->beams = photon::VolumeBeamMap::build(map->store, beam);
     map->buildSeconds = timer.seconds();
     return map;

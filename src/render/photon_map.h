@@ -14,8 +14,12 @@
 //   standard  Kind::Standard (k = ks) otherwise (static, standard,
 //             accumulation frames, a still scene);
 //   pass      Kind::Fixed with the pass's kernel (render/progressive.cpp).
-// The eye side reads maps[MapKind::Volume]->beams; it is empty (size 0)
-// when the scene has no media (no volume map traced).
+// The eye side reads maps[MapKind::Volume]->beams (volumeBeams); it is
+// empty (size 0) when the scene has no media (no volume map traced).
+// Animation frames with the Time kernel hold two (render/animation.cpp
+// frameMap): `beams` over the frame's time map, `beams3` (Standard, over
+// `store3`, the shutter's photons alone) for the skip rule's standard form,
+// as the surface maps' tree3.
 #pragma once
 #include <memory>
 #include <string>
@@ -34,16 +38,23 @@ struct PhotonMap {
   photon::KdTree tree;         // 3D, or 4D when built for the space-time search
   photon::PhotonStore store3;  // 4D maps only: a 3D-ordered copy
   photon::KdTree tree3;
-  photon::VolumeBeamMap beams;  // MapKind::Volume only: built over `store` (see the top)
+  photon::VolumeBeamMap beams;   // MapKind::Volume only: built over `store` (see the top)
+  photon::VolumeBeamMap beams3;  // animation frames' Time volume maps: the shutter's, over `store3`
   // Animations (render/animation.h): store3/tree3 hold only the frame's own
   // shutter, for the standard estimate, while `tree` spans the frame's time
   // window (its shutter plus what the time kernel may reach).
   bool separateStandard = false;
+  size_t ownPhotons = 0;  // animations: the photons of the frame's own shutter (its stats)
   uint64_t emitted = 0;
   double traceSeconds = 0, buildSeconds = 0;
   std::string warning;  // from tracing: empty map, or fewer photons than wanted
 
   const photon::KdTree& spatialTree() const { return tree.spaceTime() || separateStandard ? tree3 : tree; }
+  // The volume map the beam estimate reads: its time-dependent form reads
+  // `beams`, its standard form the shutter's own where a frame keeps one.
+  const photon::VolumeBeamMap& volumeBeams(bool timeDependent) const {
+    return separateStandard && !timeDependent ? beams3 : beams;
+  }
   size_t size() const { return store.size(); }
   double bytesPerPhoton() const;
 };
@@ -80,6 +91,16 @@ photon::TraceSettings traceSettingsFor(const RenderOptions& opt, MapKind kind, s
 // render/renderer.cpp), or the pass's path range (render/progressive.cpp).
 PerMap<PhotonMapSettings> photonMapSettingsFor(const RenderOptions& opt, const PerMap<size_t>& wanted, uint64_t seed,
                                                bool spreadInTime, float fixedTime01);
+
+// The volume map's k-NN beam kernels from the options (render/photon_map.h
+// top): Time for a time-dependent method, else Standard; k_s, the
+// fraction, --max-dt. resolvedBeamOptions then fits them to the photons: a
+// Time kernel on a scene without motion becomes Standard, an infinite max
+// time distance maxDtFraction x shutterLength (the photons' shutter: the
+// render's, a progressive frame's, an animation frame's).
+photon::BeamBuildOptions beamOptionsFor(const RenderOptions& opt);
+photon::BeamBuildOptions resolvedBeamOptions(photon::BeamBuildOptions beam, const Scene& scene, float maxDtFraction,
+                                             float shutterLength);
 
 std::unique_ptr<PhotonMap> buildPhotonMap(const Scene& scene, const PhotonMapSettings& settings,
                                           const Progress& progress);

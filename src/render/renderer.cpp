@@ -437,17 +437,21 @@ void checkMediaSupport(const Scene& scene, const RenderOptions& opt, bool stillI
   // Still images: every method. static and accumulation trace their volume
   // photons at fixed instants (shutter open; each frame's own) and read them
   // with the standard beam estimate, as their surface maps. Progressive
-  // time / standard: fresh volume photons per pass, Fixed beam kernels
+  // time / standard: fresh volume photons per pass, own k-NN beam kernels
   // shrinking per pass (render/progressive.cpp, the eye side in
   // render/photon_integrator_media.cpp). Progressive accumulation (a pass
-  // at one instant with Fixed volume kernels) is not checked in media yet.
+  // at one instant) is not checked in media yet. Animations: time and
+  // standard, fixed budget (each frame's beam map from the timeline's
+  // segments, render/animation.cpp frameMap) and progressive (each frame a
+  // progressive render of its shutter); static and accumulation have no
+  // frames (renderAnimation refuses them first).
   const bool photonMethod = opt.method == RenderMethod::Time || opt.method == RenderMethod::Standard;
   const bool fixedInstants = opt.method == RenderMethod::Static || opt.method == RenderMethod::Accumulation;
-  const bool renders = opt.method == RenderMethod::PathTrace ||
-                       (stillImage && (photonMethod || (fixedInstants && !opt.progressive)));
+  const bool renders = opt.method == RenderMethod::PathTrace || photonMethod ||
+                       (stillImage && fixedInstants && !opt.progressive);
   if (!renders)
     throw Error("the scene has participating media, which need -m pathtrace, time or standard in this version" +
-                std::string(stillImage ? " (static and accumulation: fixed budget only)" : " (animations and frames: pathtrace only)") +
+                std::string(stillImage ? " (static and accumulation: fixed budget only)" : " (animations: static and accumulation have no frames)") +
                 "; method '" + std::string(renderMethodName(opt.method)) + "'" + (opt.progressive ? " with --progressive" : "") +
                 " would render it without them");
 }

@@ -44,7 +44,8 @@ std::vector<std::string> sceneWarnings(const Scene& scene);
 // ask for what does not render them: a still image (stillImage, render())
 // takes every method (the photon methods' eye side in media:
 // render/photon_integrator_media.cpp), progressive time and standard, not
-// progressive accumulation; animations and frames pathtrace only.
+// progressive accumulation; animations and their frames pathtrace, time and
+// standard, fixed budget and progressive.
 // render(), renderFrame() and renderAnimation() call it first.
 void checkMediaSupport(const Scene& scene, const RenderOptions& options, bool stillImage = false);
 
