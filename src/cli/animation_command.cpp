@@ -233,16 +233,11 @@ ProgressiveState frameStartState(const RenderArgs& a, const scene::SceneDescript
 
 // Every frame's --resume file is checked before any frame is rendered, so a
 // wrong one costs no render and writes nothing.
-void checkResumeFiles(const RenderArgs& a, const scene::SceneDescription& desc, const scene::AnimationDesc& anim,
-                      const RenderOptions& opt, int first, int last) {
+void checkResumeFiles(const RenderArgs& a, const scene::SceneDescription& desc, const Scene& scene,
+                      const scene::AnimationDesc& anim, const RenderOptions& opt, const AnimationOptions& ao) {
   if (!a.resume) return;
-  for (int i = first; i <= last; ++i) {
-    RenderOptions fo = opt;
-    const Shutter sh = frameShutter(anim, i);
-    fo.frameOpen = sh.open;
-    fo.frameClose = sh.close;
-    (void)frameStartState(a, desc, i, fo);
-  }
+  for (int i = ao.first; i <= ao.last; ++i)
+    (void)frameStartState(a, desc, i, progressiveFrameOptions(scene, anim, opt, ao, i));
 }
 
 // One written frame, for the summary.
@@ -351,7 +346,7 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
   try {
     if (opt.progressive && ao.first <= ao.last) {
       if (a.resume) checkFramePattern(*a.resume, f.range, "--resume");
-      checkResumeFiles(a, descIn, anim, opt, ao.first, ao.last);
+      checkResumeFiles(a, descIn, *scene, anim, opt, ao);
     }
     if (ao.first <= ao.last)
       stats = renderAnimation(*scene, anim, opt, ao, bar.progress(), [&](int i, Film&& film, const RenderStats& st) {
