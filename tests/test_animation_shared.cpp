@@ -177,21 +177,7 @@ TEST_CASE("time-invariant photons: energies per unit time in both estimates, aga
   // (energy x map length / block length) and over its shutter (x shutter /
   // block length). Unscaled, the frames would read 2.5x to 4.1x too bright
   // (block length over map or shutter length).
-  auto d = test::movingPlaneScene(8);
-  d.objects[0].motion = scene::MotionDesc{};
-  auto speck = test::sphere(0.0005f, {0, 2.5f, 0}, 0);
-  // In every frame's shutter [i/4, i/4 + 1/8] it crosses a quarter of the
-  // view, from (-0.035, -0.035) to (0, 0) in x and z, and goes back while
-  // the shutter is closed.
-  for (int i = 0; i <= 4; ++i)
-    for (int half = 0; half < (i < 4 ? 2 : 1); ++half) {
-      speck.motion.times.push_back(float(i) / 4.0f + float(half) / 8.0f);
-      scene::TransformDesc pose;
-      pose.translate = half ? Vec3f{0.0f, 0.0f, 0.0f} : Vec3f{-0.035f, 0.0f, -0.035f};
-      speck.motion.poses.push_back(pose);
-    }
-  d.objects.push_back(speck);
-  d.animation = scene::AnimationDesc{4.0, 4, 180.0};
+  auto d = test::stillPlaneUnderSpeck(8);
   auto s = Scene::build(d);
   double want = 0;
   for (int y = 0; y < 8; ++y)
