@@ -21,10 +21,14 @@
 #include "render/renderer.h"
 #include "scene/scene.h"
 #include "moving_plane.h"
+#include "render_fixtures.h"
 #include "scene_fixtures.h"
+#include "seed_stats.h"
 #include "shadow_sweep.h"
 
 using namespace tdpm;
+using test::meanRed;
+using test::overSeeds;
 
 namespace {
 
@@ -73,29 +77,10 @@ Sequence render(const Scene& s, const scene::AnimationDesc& a, const RenderOptio
   return q;
 }
 
-double meanRed(const Film& f, int x0, int y0, int x1, int y1) {
-  double s = 0;
-  for (int y = y0; y < y1; ++y)
-    for (int x = x0; x < x1; ++x) s += f.color[f.index(x, y)].r;
-  return s / double((x1 - x0) * (y1 - y0));
-}
 
-struct MeanAndError {
-  double mean = 0, se = 0;
-};
-MeanAndError overSeeds(const std::vector<double>& v) {
-  const double n = double(v.size());
-  MeanAndError r;
-  for (double x : v) r.mean += x / n;
-  double ss = 0;
-  for (double x : v) ss += (x - r.mean) * (x - r.mean);
-  r.se = std::sqrt(ss / (n - 1.0) / n);
-  return r;
-}
-
-bool sameImage(const Film& a, const Film& b) {
-  return a.color.size() == b.color.size() &&
-         std::memcmp(a.color.data(), b.color.data(), a.color.size() * sizeof(Rgb)) == 0 &&
+// Colour (tests/render_fixtures.h) and the variance layer, bit for bit.
+bool samePixels(const Film& a, const Film& b) {
+  return test::sameImage(a, b) &&
          std::memcmp(a.varianceOfMean.data(), b.varianceOfMean.data(), a.varianceOfMean.size() * sizeof(Rgb)) == 0;
 }
 
@@ -204,10 +189,10 @@ TEST_CASE("progressive shared frames resume bit for bit, also with a block's fra
   CHECK(resumed.all.sharedSets == 3);  // passes 1, 2, 3: frame 1 alone at pass 1
   for (int i = 0; i < 3; ++i) {
     CHECK(resumed.states[i].passesDone == 4);
-    CHECK(sameImage(full.films[i], resumed.films[i]));
+    CHECK(samePixels(full.films[i], resumed.films[i]));
   }
   Sequence later = render(*s, *d.animation, sweepOptions(9, 4), frames(1, 2, 4, 0.5, 0.5));
-  for (int i = 1; i < 3; ++i) CHECK(sameImage(full.films[i], later.films[i]));
+  for (int i = 1; i < 3; ++i) CHECK(samePixels(full.films[i], later.films[i]));
   // A finished state is skipped: nothing traced, nothing rendered.
   Sequence again = render(*s, *d.animation, sweepOptions(9, 4), ao, &full.states);
   CHECK(again.films.empty());

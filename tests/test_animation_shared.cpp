@@ -23,6 +23,7 @@
 #include "scene/scene.h"
 #include "moving_plane.h"
 #include "scene_fixtures.h"
+#include "seed_stats.h"
 #include "shadow_sweep.h"
 
 using namespace tdpm;
@@ -32,6 +33,8 @@ namespace {
 constexpr Vec3f kLight = test::kSweepLight;  // tests/shadow_sweep.h
 
 using test::shadowSweep;  // tests/shadow_sweep.h
+using test::meanRed;      // tests/seed_stats.h
+using test::overSeeds;
 
 RenderOptions shadowOptions(uint64_t seed) {
   RenderOptions o;
@@ -75,27 +78,6 @@ AnimationOptions frames(int first, int last, int window, double shared) {
   return ao;
 }
 
-// Mean red over pixels [x0, x1) x [y0, y1).
-double meanRed(const Film& f, int x0, int y0, int x1, int y1) {
-  double s = 0;
-  for (int y = y0; y < y1; ++y)
-    for (int x = x0; x < x1; ++x) s += f.color[f.index(x, y)].r;
-  return s / double((x1 - x0) * (y1 - y0));
-}
-double meanRed(const Film& f) { return meanRed(f, 0, 0, f.width, f.height); }
-
-struct MeanAndError {
-  double mean = 0, se = 0;
-};
-MeanAndError overSeeds(const std::vector<double>& v) {
-  const double n = double(v.size());
-  MeanAndError r;
-  for (double x : v) r.mean += x / n;
-  double ss = 0;
-  for (double x : v) ss += (x - r.mean) * (x - r.mean);
-  r.se = std::sqrt(ss / (n - 1.0) / n);
-  return r;
-}
 
 // One block's photons of one mode, as the animation traces them: over
 // frames 0-1's time, Sobol paths (each path's numbers depend only on its
