@@ -357,7 +357,10 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
         if (kept) addProgressiveState(std::move(*kept), exr);
         kept.reset();
         writeRenderOutputs(f.outputs[k], f.previews[k], exr, exposure);
-        lines.push_back({i, frameTimer.seconds(), st.cameraSamples, st.minSpp, st.maxSpp});
+        // A progressive frame's own passes (frames sharing a block's photons
+        // are written together after the block's last round: the time since
+        // the last frame was written would give the block's to its first).
+        lines.push_back({i, opt.progressive ? st.seconds : frameTimer.seconds(), st.cameraSamples, st.minSpp, st.maxSpp});
         frameTimer.reset();
         peakRss = std::max(peakRss, st.peakResidentBytes);
       });
