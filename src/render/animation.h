@@ -105,6 +105,11 @@ struct AnimationStats {
 // the frame: its maps' sizes), in frame order; the caller writes the files.
 using FrameSink = std::function<void(int frame, Film&& film, const RenderStats& stats)>;
 
+// --progressive frames sharing each pass's time-invariant photons over
+// blocks of animationOptions.window frames (--shared-photons > 0, a scene
+// without media): render/animation_progressive.h.
+bool progressiveFramesShare(const Scene& scene, const RenderOptions& options, const AnimationOptions& animationOptions);
+
 // --progressive: frame `frame`'s options, its shutter as frameOpen /
 // frameClose and, when its passes share the time-invariant photons of its
 // block, what they depend on as frameSharing (both in the fingerprint).

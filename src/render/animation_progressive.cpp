@@ -27,10 +27,6 @@ namespace tdpm {
 
 namespace {
 
-bool sharesPhotons(const Scene& scene, const RenderOptions& opt, const AnimationOptions& ao) {
-  return opt.progressive && ao.sharedScale > 0 && !scene.hasMedia();
-}
-
 // Continue the paths that meet motion from the block pass's states
 // (section 8), as the fixed-budget frames do.
 bool continuing(const AnimationOptions& ao) { return ao.continuePaths; }
@@ -320,13 +316,17 @@ void renderSharedBlock(const Scene& scene, const scene::AnimationDesc& anim, con
 
 }  // namespace
 
+bool progressiveFramesShare(const Scene& scene, const RenderOptions& opt, const AnimationOptions& ao) {
+  return opt.progressive && ao.sharedScale > 0 && !scene.hasMedia();
+}
+
 RenderOptions progressiveFrameOptions(const Scene& scene, const scene::AnimationDesc& anim, const RenderOptions& opt,
                                       const AnimationOptions& ao, int frame) {
   RenderOptions fo = opt;
   const Shutter sh = frameShutter(anim, frame);
   fo.frameOpen = sh.open;
   fo.frameClose = sh.close;
-  if (sharesPhotons(scene, opt, ao)) {
+  if (progressiveFramesShare(scene, opt, ao)) {
     int f0, f1;
     blockOf(anim, ao, frame, f0, f1);
     fo.frameSharing = "frames " + std::to_string(f0) + "-" + std::to_string(f1) + " (window " +
@@ -344,7 +344,7 @@ AnimationStats renderProgressiveFrames(const Scene& scene, const scene::Animatio
   progress.at(WorkPosition{"frame", 0, total, 0, 0});
   uint64_t emitted = 0;
   size_t done = 0;
-  if (sharesPhotons(scene, opt, ao)) {
+  if (progressiveFramesShare(scene, opt, ao)) {
     for (int b0 = ao.first; b0 <= ao.last;) {
       const int b1 = std::min(ao.last, (b0 / ao.window + 1) * ao.window - 1);
       renderSharedBlock(scene, anim, opt, ao, b0, b1, progress, done, emitted, stats, sink);
