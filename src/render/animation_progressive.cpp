@@ -282,6 +282,9 @@ void renderSharedBlock(const Scene& scene, const scene::AnimationDesc& anim, con
     frames.push_back(std::move(f));
   }
   if (frames.empty()) return;
+  // The frames' states (7 float layers a pixel each: render/progressive_state.h).
+  const uint64_t pixels = uint64_t(scene.camera.width()) * uint64_t(scene.camera.height());
+  checkBlockStatesMemory(frames.size(), pixels * 7 * sizeof(float), availableMemoryBytes(), ao.window);
   SharedPasses shared(scene, anim, opt, ao, b0, stats);
   addWarnings(stats, shared.warnings());
   Timer timer;
