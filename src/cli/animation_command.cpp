@@ -295,6 +295,31 @@ void printAnimationSummary(const RenderArgs& a, const RenderOptions& opt, const 
   }
 }
 
+// The flags' animation options and this rank's frames. Under mpirun the
+// frames are split over the ranks in contiguous blocks (a frame's image
+// depends only on its index, so any split writes what one process would),
+// each rank writing its own frames; rank 0 prints and assembles the video
+// once every rank has finished (docs/distributed.md). Progressive frames
+// sharing a block's photons are split by whole blocks of --window frames,
+// so that no two ranks trace one block's sets.
+AnimationOptions rankAnimationOptions(const RenderArgs& a, const Scene& scene, const RenderOptions& opt,
+                                      const FrameOutputs& f, dist::Comm& comm) {
+  AnimationOptions ao;
+  ao.window = a.window.value_or(ao.window);
+  ao.independentFrames = a.independentFrames;
+  ao.sharedScale = a.sharedPhotons.value_or(ao.sharedScale);
+  ao.movingScale = a.movingPhotons.value_or(ao.movingScale);
+  if (a.continuePaths || a.noContinuePaths) ao.continuePaths = a.continuePaths;
+  const int unit = progressiveFramesShare(scene, opt, ao) ? ao.window : 1;
+  const int firstFrame = f.range.first, lastFrame = f.range.first + int(f.range.count()) - 1;
+  const int u0 = firstFrame / unit, u1 = lastFrame / unit;
+  uint64_t lo = 0, hi = 0;
+  dist::blockRange(uint64_t(u1 - u0 + 1), comm.rank(), comm.size(), lo, hi);
+  ao.first = std::max(firstFrame, (u0 + int(lo)) * unit);
+  ao.last = lo == hi ? ao.first - 1 : std::min(lastFrame, (u0 + int(hi)) * unit - 1);
+  return ao;
+}
+
 }  // namespace
 
 // One level: the outputs (every rank checks), this rank's block of frames
@@ -320,25 +345,7 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
   std::FILE* barStream = ProgressBar::stream(a.quiet, comm.distributed());  // none under mpirun
   ProgressBar bar(comm.root() && barStream, barStream ? barStream : stderr);
   auto scene = Scene::build(descIn);
-  AnimationOptions ao;
-  ao.window = a.window.value_or(ao.window);
-  ao.independentFrames = a.independentFrames;
-  ao.sharedScale = a.sharedPhotons.value_or(ao.sharedScale);
-  ao.movingScale = a.movingPhotons.value_or(ao.movingScale);
-  if (a.continuePaths || a.noContinuePaths) ao.continuePaths = a.continuePaths;
-  // Under mpirun the frames are split over the ranks in contiguous blocks
-  // (a frame's image depends only on its index, so any split writes what one
-  // process would), each rank writing its own frames; rank 0 prints and
-  // assembles the video once every rank has finished (docs/distributed.md).
-  // Progressive frames sharing a block's photons are split by whole blocks
-  // of --window frames, so that no two ranks trace one block's sets.
-  const int unit = progressiveFramesShare(*scene, opt, ao) ? ao.window : 1;
-  const int firstFrame = f.range.first, lastFrame = f.range.first + int(f.range.count()) - 1;
-  const int u0 = firstFrame / unit, u1 = lastFrame / unit;
-  uint64_t blockLo = 0, blockHi = 0;
-  dist::blockRange(uint64_t(u1 - u0 + 1), comm.rank(), comm.size(), blockLo, blockHi);
-  ao.first = std::max(firstFrame, (u0 + int(blockLo)) * unit);
-  ao.last = blockLo == blockHi ? ao.first - 1 : std::min(lastFrame, (u0 + int(blockHi)) * unit - 1);
+  AnimationOptions ao = rankAnimationOptions(a, *scene, opt, f, comm);
   std::optional<ProgressiveState> kept;  // the frame's state, written with it
   if (opt.progressive) {
     ao.startState = [&](int i, const RenderOptions& fo) { return frameStartState(a, descIn, i, fo); };
