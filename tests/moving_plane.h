@@ -74,4 +74,28 @@ inline RenderOptions movingPlaneFrameOptions(uint64_t seed) {
   return o;
 }
 
+// The moving plane held still, and the only moving thing a speck above the
+// light, in the camera's view (x and z within +-0.035 at y = 2.5), over 4
+// frames at 4 fps (180 degrees): in every frame's shutter [i/4, i/4 + 1/8]
+// it crosses a quarter of the view, from (-0.035, -0.035) to (0, 0) in x
+// and z, and goes back while the shutter is closed. Every photon (light ->
+// plane) is time-invariant; eye paths through the speck's swept bounds use
+// the time-dependent estimate, the others the standard one. The plane's
+// exact pixels: movingPlanePixel(cam, shutter, x, y, 0, 0, 1).
+inline scene::SceneDescription stillPlaneUnderSpeck(int res) {
+  auto d = movingPlaneScene(res);
+  d.objects[0].motion = scene::MotionDesc{};
+  auto speck = sphere(0.0005f, {0, 2.5f, 0}, 0);
+  for (int i = 0; i <= 4; ++i)
+    for (int half = 0; half < (i < 4 ? 2 : 1); ++half) {
+      speck.motion.times.push_back(float(i) / 4.0f + float(half) / 8.0f);
+      scene::TransformDesc pose;
+      pose.translate = half ? Vec3f{0.0f, 0.0f, 0.0f} : Vec3f{-0.035f, 0.0f, -0.035f};
+      speck.motion.poses.push_back(pose);
+    }
+  d.objects.push_back(speck);
+  d.animation = scene::AnimationDesc{4.0, 4, 180.0};
+  return d;
+}
+
 }  // namespace tdpm::test

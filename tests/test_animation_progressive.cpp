@@ -24,8 +24,12 @@
 #include "scene/scene.h"
 #include "moving_plane.h"
 #include "scene_fixtures.h"
+#include "seed_stats.h"
 
 using namespace tdpm;
+using test::meanRed;
+using test::overSeeds;
+using test::MeanAndError;
 
 namespace {
 
@@ -51,11 +55,6 @@ RenderOptions progressiveOptions(uint64_t seed, int passes) {
   return o;
 }
 
-double meanRed(const Film& f) {
-  double s = 0;
-  for (const Rgb& c : f.color) s += c.r;
-  return s / double(f.color.size());
-}
 
 struct Frames {
   std::vector<int> index;
@@ -83,19 +82,6 @@ double analyticFrame(const Scene& s, const scene::AnimationDesc& a, int frame) {
   return want / 64.0;
 }
 
-struct MeanAndError {
-  double mean = 0, se = 0;
-};
-
-MeanAndError overSeeds(const std::vector<double>& v) {
-  const double n = double(v.size());
-  MeanAndError r;
-  for (double x : v) r.mean += x / n;
-  double ss = 0;
-  for (double x : v) ss += (x - r.mean) * (x - r.mean);
-  r.se = std::sqrt(ss / (n - 1.0) / n);
-  return r;
-}
 
 }  // namespace
 

@@ -23,6 +23,7 @@
 #include "scene/scene.h"
 #include "moving_plane.h"
 #include "scene_fixtures.h"
+#include "seed_stats.h"
 #include "shadow_sweep.h"
 
 using namespace tdpm;
@@ -32,6 +33,8 @@ namespace {
 constexpr Vec3f kLight = test::kSweepLight;  // tests/shadow_sweep.h
 
 using test::shadowSweep;  // tests/shadow_sweep.h
+using test::meanRed;      // tests/seed_stats.h
+using test::overSeeds;
 
 RenderOptions shadowOptions(uint64_t seed) {
   RenderOptions o;
@@ -75,27 +78,6 @@ AnimationOptions frames(int first, int last, int window, double shared) {
   return ao;
 }
 
-// Mean red over pixels [x0, x1) x [y0, y1).
-double meanRed(const Film& f, int x0, int y0, int x1, int y1) {
-  double s = 0;
-  for (int y = y0; y < y1; ++y)
-    for (int x = x0; x < x1; ++x) s += f.color[f.index(x, y)].r;
-  return s / double((x1 - x0) * (y1 - y0));
-}
-double meanRed(const Film& f) { return meanRed(f, 0, 0, f.width, f.height); }
-
-struct MeanAndError {
-  double mean = 0, se = 0;
-};
-MeanAndError overSeeds(const std::vector<double>& v) {
-  const double n = double(v.size());
-  MeanAndError r;
-  for (double x : v) r.mean += x / n;
-  double ss = 0;
-  for (double x : v) ss += (x - r.mean) * (x - r.mean);
-  r.se = std::sqrt(ss / (n - 1.0) / n);
-  return r;
-}
 
 // One block's photons of one mode, as the animation traces them: over
 // frames 0-1's time, Sobol paths (each path's numbers depend only on its
@@ -177,21 +159,7 @@ TEST_CASE("time-invariant photons: energies per unit time in both estimates, aga
   // (energy x map length / block length) and over its shutter (x shutter /
   // block length). Unscaled, the frames would read 2.5x to 4.1x too bright
   // (block length over map or shutter length).
-  auto d = test::movingPlaneScene(8);
-  d.objects[0].motion = scene::MotionDesc{};
-  auto speck = test::sphere(0.0005f, {0, 2.5f, 0}, 0);
-  // In every frame's shutter [i/4, i/4 + 1/8] it crosses a quarter of the
-  // view, from (-0.035, -0.035) to (0, 0) in x and z, and goes back while
-  // the shutter is closed.
-  for (int i = 0; i <= 4; ++i)
-    for (int half = 0; half < (i < 4 ? 2 : 1); ++half) {
-      speck.motion.times.push_back(float(i) / 4.0f + float(half) / 8.0f);
-      scene::TransformDesc pose;
-      pose.translate = half ? Vec3f{0.0f, 0.0f, 0.0f} : Vec3f{-0.035f, 0.0f, -0.035f};
-      speck.motion.poses.push_back(pose);
-    }
-  d.objects.push_back(speck);
-  d.animation = scene::AnimationDesc{4.0, 4, 180.0};
+  auto d = test::stillPlaneUnderSpeck(8);
   auto s = Scene::build(d);
   double want = 0;
   for (int y = 0; y < 8; ++y)

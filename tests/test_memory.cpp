@@ -276,3 +276,20 @@ TEST_CASE("memory: an animation block's kept path states are checked against the
   CHECK_NOTHROW(checkKeptStatesMemory(1000000, 56, GiB, 3 * GiB / 2, 4));
   CHECK_NOTHROW(checkKeptStatesMemory(uint64_t(1) << 40, 56, 0, 0, 4));  // unknown memory: no check
 }
+
+TEST_CASE("memory: progressive frames sharing a block hold every frame's state, checked against the memory available") {
+  const uint64_t GiB = uint64_t(1) << 30;
+  // 3840x2160 at 7 float layers = 232 MB a frame: 4 fit 2 GiB, 16 do not.
+  const uint64_t frame = uint64_t(3840) * 2160 * 7 * 4;
+  CHECK_NOTHROW(checkBlockStatesMemory(4, frame, 2 * GiB, 4));
+  std::string e;
+  try {
+    checkBlockStatesMemory(16, frame, 2 * GiB, 16);
+  } catch (const std::exception& ex) {
+    e = ex.what();
+  }
+  INFO(e);
+  CHECK(e.find("states of 16 frames at once (--window 16") != std::string::npos);
+  CHECK(e.find("--shared-photons 0") != std::string::npos);
+  CHECK_NOTHROW(checkBlockStatesMemory(uint64_t(1) << 20, frame, 0, 4));  // unknown memory: no check
+}

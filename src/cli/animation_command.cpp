@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -233,16 +234,11 @@ ProgressiveState frameStartState(const RenderArgs& a, const scene::SceneDescript
 
 // Every frame's --resume file is checked before any frame is rendered, so a
 // wrong one costs no render and writes nothing.
-void checkResumeFiles(const RenderArgs& a, const scene::SceneDescription& desc, const scene::AnimationDesc& anim,
-                      const RenderOptions& opt, int first, int last) {
+void checkResumeFiles(const RenderArgs& a, const scene::SceneDescription& desc, const Scene& scene,
+                      const scene::AnimationDesc& anim, const RenderOptions& opt, const AnimationOptions& ao) {
   if (!a.resume) return;
-  for (int i = first; i <= last; ++i) {
-    RenderOptions fo = opt;
-    const Shutter sh = frameShutter(anim, i);
-    fo.frameOpen = sh.open;
-    fo.frameClose = sh.close;
-    (void)frameStartState(a, desc, i, fo);
-  }
+  for (int i = ao.first; i <= ao.last; ++i)
+    (void)frameStartState(a, desc, i, progressiveFrameOptions(scene, anim, opt, ao, i));
 }
 
 // One written frame, for the summary.
@@ -299,6 +295,31 @@ void printAnimationSummary(const RenderArgs& a, const RenderOptions& opt, const 
   }
 }
 
+// The flags' animation options and this rank's frames. Under mpirun the
+// frames are split over the ranks in contiguous blocks (a frame's image
+// depends only on its index, so any split writes what one process would),
+// each rank writing its own frames; rank 0 prints and assembles the video
+// once every rank has finished (docs/distributed.md). Progressive frames
+// sharing a block's photons are split by whole blocks of --window frames,
+// so that no two ranks trace one block's sets.
+AnimationOptions rankAnimationOptions(const RenderArgs& a, const Scene& scene, const RenderOptions& opt,
+                                      const FrameOutputs& f, dist::Comm& comm) {
+  AnimationOptions ao;
+  ao.window = a.window.value_or(ao.window);
+  ao.independentFrames = a.independentFrames;
+  ao.sharedScale = a.sharedPhotons.value_or(ao.sharedScale);
+  ao.movingScale = a.movingPhotons.value_or(ao.movingScale);
+  if (a.continuePaths || a.noContinuePaths) ao.continuePaths = a.continuePaths;
+  const int unit = progressiveFramesShare(scene, opt, ao) ? ao.window : 1;
+  const int firstFrame = f.range.first, lastFrame = f.range.first + int(f.range.count()) - 1;
+  const int u0 = firstFrame / unit, u1 = lastFrame / unit;
+  uint64_t lo = 0, hi = 0;
+  dist::blockRange(uint64_t(u1 - u0 + 1), comm.rank(), comm.size(), lo, hi);
+  ao.first = std::max(firstFrame, (u0 + int(lo)) * unit);
+  ao.last = lo == hi ? ao.first - 1 : std::min(lastFrame, (u0 + int(hi)) * unit - 1);
+  return ao;
+}
+
 }  // namespace
 
 // One level: the outputs (every rank checks), this rank's block of frames
@@ -321,23 +342,10 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
   dist::raiseIfAnyFailed(comm, setupError);
 
   ThreadLimit limit(a.threads);
-  // Under mpirun the frames are split over the ranks in contiguous blocks
-  // (a frame's image depends only on its index, so any split writes what one
-  // process would), each rank writing its own frames; rank 0 prints and
-  // assembles the video once every rank has finished (docs/distributed.md).
-  uint64_t blockLo = 0, blockHi = 0;
-  dist::blockRange(uint64_t(f.range.count()), comm.rank(), comm.size(), blockLo, blockHi);
   std::FILE* barStream = ProgressBar::stream(a.quiet, comm.distributed());  // none under mpirun
   ProgressBar bar(comm.root() && barStream, barStream ? barStream : stderr);
   auto scene = Scene::build(descIn);
-  AnimationOptions ao;
-  ao.first = f.range.first + int(blockLo);
-  ao.last = f.range.first + int(blockHi) - 1;
-  ao.window = a.window.value_or(ao.window);
-  ao.independentFrames = a.independentFrames;
-  ao.sharedScale = a.sharedPhotons.value_or(ao.sharedScale);
-  ao.movingScale = a.movingPhotons.value_or(ao.movingScale);
-  if (a.continuePaths || a.noContinuePaths) ao.continuePaths = a.continuePaths;
+  AnimationOptions ao = rankAnimationOptions(a, *scene, opt, f, comm);
   std::optional<ProgressiveState> kept;  // the frame's state, written with it
   if (opt.progressive) {
     ao.startState = [&](int i, const RenderOptions& fo) { return frameStartState(a, descIn, i, fo); };
@@ -351,7 +359,7 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
   try {
     if (opt.progressive && ao.first <= ao.last) {
       if (a.resume) checkFramePattern(*a.resume, f.range, "--resume");
-      checkResumeFiles(a, descIn, anim, opt, ao.first, ao.last);
+      checkResumeFiles(a, descIn, *scene, anim, opt, ao);
     }
     if (ao.first <= ao.last)
       stats = renderAnimation(*scene, anim, opt, ao, bar.progress(), [&](int i, Film&& film, const RenderStats& st) {
@@ -362,7 +370,10 @@ int runAnimation(const RenderArgs& a, const scene::SceneDescription& descIn, con
         if (kept) addProgressiveState(std::move(*kept), exr);
         kept.reset();
         writeRenderOutputs(f.outputs[k], f.previews[k], exr, exposure);
-        lines.push_back({i, frameTimer.seconds(), st.cameraSamples, st.minSpp, st.maxSpp});
+        // A progressive frame's own passes (frames sharing a block's photons
+        // are written together after the block's last round: the time since
+        // the last frame was written would give the block's to its first).
+        lines.push_back({i, opt.progressive ? st.seconds : frameTimer.seconds(), st.cameraSamples, st.minSpp, st.maxSpp});
         frameTimer.reset();
         peakRss = std::max(peakRss, st.peakResidentBytes);
       });

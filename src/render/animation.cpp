@@ -17,7 +17,7 @@
 #include "photon/tracer.h"
 #include "render/memory_budget.h"
 #include "render/photon_map.h"
-#include "render/progressive.h"
+#include "render/animation_progressive.h"
 
 namespace tdpm {
 
@@ -183,52 +183,6 @@ std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments,
   map->store3 = frameStore(segments, shared, kind, g, own);
   map->tree3 = photon::KdTree::build(map->store3, {});
   return map;
-}
-
-// --progressive: each frame is a progressive render of its own (the pass
-// loop of render/progressive.h, a fresh state per frame: --passes and
-// --time-limit are per frame), every pass's photons traced over the frame's
-// shutter and its camera samples taken in it (RenderOptions::frameOpen /
-// frameClose). No pads: the fixed kernel clips its time window to the
-// photons' range, so it needs no photons beyond the shutter.
-AnimationStats renderProgressiveFrames(const Scene& scene, const scene::AnimationDesc& anim, const RenderOptions& opt,
-                                       const AnimationOptions& ao, const Progress& progress, const FrameSink& sink) {
-  AnimationStats stats;
-  const size_t total = size_t(ao.last - ao.first + 1);
-  progress.at(WorkPosition{"frame", 0, total, 0, 0});
-  uint64_t emitted = 0;
-  for (int i = ao.first; i <= ao.last; ++i) {
-    const std::string prefix =
-        "frame " + std::to_string(i) + " (" + std::to_string(i - ao.first + 1) + "/" + std::to_string(total) + "): ";
-    Progress framed;  // stages prefixed by the frame; the pass positions stay the frame loop's
-    framed.report = [&](const std::string& stage, size_t done, size_t all) { progress(prefix + stage, done, all); };
-    RenderOptions frameOpt = opt;
-    const Shutter sh = frameShutter(anim, i);
-    frameOpt.frameOpen = sh.open;
-    frameOpt.frameClose = sh.close;
-    ProgressiveState state = ao.startState ? ao.startState(i, frameOpt) : ProgressiveState{};
-    if (opt.passes > 0 && state.passesDone >= opt.passes) {  // finished in an earlier run: its file stays
-      ++stats.framesSkipped;
-      progress.at(WorkPosition{"frame", size_t(i - ao.first + 1), total, 0, emitted});
-      continue;
-    }
-    const int resumedAt = state.passesDone;
-    RenderStats st;
-    Film film = renderProgressive(scene, frameOpt, state, framed, st);
-    for (const std::string& w : st.warnings)
-      if (std::find(stats.warnings.begin(), stats.warnings.end(), w) == stats.warnings.end()) stats.warnings.push_back(w);
-    stats.photonSeconds += st.photonSeconds;
-    for (MapKind k : kAllMapKinds) {
-      stats.maps[k].stored += st.maps[k].stored;
-      stats.maps[k].emitted += st.maps[k].emitted;
-      emitted += st.maps[k].emitted;
-    }
-    stats.passesDone += uint64_t(state.passesDone - resumedAt);  // this run's
-    if (ao.keepState) ao.keepState(i, std::move(state));
-    sink(i, std::move(film), st);
-    progress.at(WorkPosition{"frame", size_t(i - ao.first + 1), total, 0, emitted});
-  }
-  return stats;
 }
 
 }  // namespace

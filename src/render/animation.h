@@ -105,12 +105,26 @@ struct AnimationStats {
 // the frame: its maps' sizes), in frame order; the caller writes the files.
 using FrameSink = std::function<void(int frame, Film&& film, const RenderStats& stats)>;
 
+// --progressive frames sharing each pass's time-invariant photons over
+// blocks of animationOptions.window frames (--shared-photons > 0, a scene
+// without media): render/animation_progressive.h.
+bool progressiveFramesShare(const Scene& scene, const RenderOptions& options, const AnimationOptions& animationOptions);
+
+// --progressive: frame `frame`'s options, its shutter as frameOpen /
+// frameClose and, when its passes share the time-invariant photons of its
+// block, what they depend on as frameSharing (both in the fingerprint).
+RenderOptions progressiveFrameOptions(const Scene& scene, const scene::AnimationDesc& animation,
+                                      const RenderOptions& options, const AnimationOptions& animationOptions,
+                                      int frame);
+
 // Renders options.first..options.last. Methods: time, standard, pathtrace
 // (others are refused with an Error). `--photons` counts are per frame's
 // shutter time. Reports progress.at(WorkPosition{"frame", ...}).
 // options.progressive: each frame is a progressive render (time, standard;
 // --passes / --time-limit per frame), its passes' photons and camera samples
-// in the frame's shutter; the window and segments are not used.
+// in the frame's shutter; no segments; with sharing the frames of a block
+// of `window` share each pass's time-invariant photons
+// (render/animation_progressive.h).
 AnimationStats renderAnimation(const Scene& scene, const scene::AnimationDesc& animation, const RenderOptions& options,
                                const AnimationOptions& animationOptions, const Progress& progress,
                                const FrameSink& sink);

@@ -110,6 +110,7 @@ std::map<std::string, std::string> renderSettings(const RenderOptions& o, int wi
   // An animation frame rendered in passes: its shutter, so that frame i's
   // state cannot be resumed as frame j's (only then: stills keep theirs).
   if (std::isfinite(o.frameOpen)) s["frame_shutter"] = floatText(o.frameOpen) + " to " + floatText(o.frameClose);
+  if (!o.frameSharing.empty()) s["frame_sharing"] = o.frameSharing;  // likewise: only when its passes share photons
   if (!o.gatherGuide) s["gather_guide"] = "off";  // likewise (only when off, its default since 2026-12): states made before it resume
   return s;
 }

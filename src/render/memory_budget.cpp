@@ -114,6 +114,20 @@ void checkKeptStatesMemory(uint64_t paths, uint64_t bytesPerState, uint64_t held
               "with --no-continue-paths");
 }
 
+void checkBlockStatesMemory(uint64_t frames, uint64_t bytesPerFrame, uint64_t available, int window) {
+  if (available == 0) return;
+  const uint64_t margin = memoryMarginBytes(available);
+  const uint64_t usable = available > margin ? available - margin : 0;
+  const double needed = double(frames) * double(bytesPerFrame);
+  if (needed <= double(usable)) return;
+  throw Error("--progressive frames sharing their block's photons hold the states of " + std::to_string(frames) +
+              " frames at once (--window " + std::to_string(window) + ", " + formatBytes(bytesPerFrame) +
+              " each: " + formatBytes(uint64_t(needed)) + "), but only " + formatBytes(usable) +
+              " of memory is available (MemAvailable " + formatBytes(available) + " less a margin of " +
+              formatBytes(margin) + "); lower --window or the resolution, or render each frame alone with "
+              "--shared-photons 0");
+}
+
 void checkPhotonMemory(const PerMap<size_t>& stored, bool spaceTime4D, int maxDepth, uint64_t available,
                        const PerMap<std::string>& sources) {
   if (available == 0) return;  // unknown: better to try than to refuse

@@ -49,6 +49,12 @@ void checkPhotonMemory(const PerMap<size_t>& stored, bool spaceTime4D, int maxDe
 // means unknown: no check.
 void checkKeptStatesMemory(uint64_t paths, uint64_t bytesPerState, uint64_t held, uint64_t available, int window);
 
+// Progressive frames sharing a block's photons (render/animation_progressive.cpp)
+// hold the states of the block's `frames` frames at once, `bytesPerFrame`
+// each (their float layers). Throws tdpm::Error naming --window when they
+// exceed `available` less memoryMarginBytes; available == 0: no check.
+void checkBlockStatesMemory(uint64_t frames, uint64_t bytesPerFrame, uint64_t available, int window);
+
 struct MemoryEstimate {
   uint64_t pixels = 0;
   uint64_t films = 0;    // the films alive while rendering (accumulation: 3)

@@ -337,7 +337,8 @@ Progress cancellable(const Progress& progress) {
 // warnings go to `st`; the rest is in the figures, for addPass.
 PassFigures computePass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state, int pass,
                         const std::vector<uint32_t>& counts, const Progress& progress, RenderStats& st,
-                        std::vector<float>& mean, const std::function<void()>& afterPilot) {
+                        std::vector<float>& mean, const std::function<void()>& afterPilot,
+                        const PassMapSource& source = {}) {
   Timer timer;
   const RenderMethodTraits& method = renderMethodTraits(opt.method);
   const bool accumulation = method.inBetweenFrames;  // a pass is one frame, at its own instant
@@ -366,7 +367,7 @@ PassFigures computePass(const Scene& scene, const RenderOptions& opt, Progressiv
   const bool timeDependent = renderMethodTraits(opt.method).timeDependentEstimate && scene.hasMotion;
   // The volume map's pass kernel: its own k-NN, shrunk by the schedule.
   settings[MapKind::Volume].beam = volumePassBeam(settings[MapKind::Volume].beam, opt, pass, timeDependent);
-  PhotonMaps maps = buildPhotonMaps(scene, settings, progress);
+  PhotonMaps maps = source ? source(pass, progress) : buildPhotonMaps(scene, settings, progress);
   double photonSeconds = 0;
   for (MapKind kind : kAllMapKinds) {
     const PhotonMap& m = *maps[kind];
@@ -531,9 +532,10 @@ PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& o
 }
 
 void runProgressivePass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
-                        const Progress& progress, RenderStats& st, const std::vector<uint32_t>& counts) {
+                        const Progress& progress, RenderStats& st, const std::vector<uint32_t>& counts,
+                        const PassMapSource& source) {
   std::vector<float> mean;
-  PassFigures f = computePass(scene, opt, state, state.passesDone, counts, progress, st, mean, {});
+  PassFigures f = computePass(scene, opt, state, state.passesDone, counts, progress, st, mean, {}, source);
   std::string overflow = addPass(scene, opt, state, mean.data(), counts, f, st);
   if (!overflow.empty()) throw Error(overflow);
 }
@@ -686,10 +688,8 @@ bool runDistributedRounds(const Scene& scene, const RenderOptions& opt, Progress
 
 }  // namespace
 
-// One level: the checks, the state, the pass loop (local or in rounds over
-// the ranks), the film from the sums.
-Film renderProgressive(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
-                       const Progress& progress, RenderStats& st, dist::Comm& comm) {
+ProgressiveStart startProgressive(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
+                                  const Progress& progress, RenderStats& st, dist::Comm& comm) {
   if (!renderMethodTraits(opt.method).progressive)
     throw Error("--progressive works with the methods time, accumulation and standard, not '" +
                 std::string(renderMethodName(opt.method)) + "'");
@@ -714,22 +714,46 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
     state.passesDone = comm.broadcastInt(state.passesDone);
     if (!state.empty()) sharePilot(comm, state);
   }
-  Timer timer;
   st = RenderStats{};
   st.warnings = sceneWarnings(scene);
-  const int w = scene.camera.width(), h = scene.camera.height();
-  const size_t n = size_t(w) * size_t(h);
-  prepareState(state, opt, w, h, comm);
-  double limit = opt.timeLimitSeconds;
-  if (opt.passes <= 0 && !(limit > 0)) limit = kDefaultProgressiveSeconds;
-  progress.at(passPosition(state, opt, limit));
+  prepareState(state, opt, scene.camera.width(), scene.camera.height(), comm);
+  ProgressiveStart start;
+  start.limit = opt.timeLimitSeconds;
+  if (opt.passes <= 0 && !(start.limit > 0)) start.limit = kDefaultProgressiveSeconds;
+  progress.at(passPosition(state, opt, start.limit));
   // Samples per pixel and pass: the same map in every run and on every rank
   // (a function of scene, options and seed; render/sample_allocation.h).
-  const std::vector<uint32_t> counts = passSampleCounts(scene, opt, progress, comm);
+  start.counts = passSampleCounts(scene, opt, progress, comm);
+  return start;
+}
+
+Film finishProgressive(const Scene& scene, const ProgressiveState& state, RenderStats& st, double seconds) {
+  const int w = scene.camera.width(), h = scene.camera.height();
+  Film film = filmFromState(state, w, h);
+  st.cameraSamples = 0;
+  st.minSpp = film.sampleCount.empty() ? 0 : int(film.sampleCount[0]);
+  st.maxSpp = st.minSpp;
+  for (float c : film.sampleCount) {
+    st.cameraSamples += uint64_t(c);
+    st.minSpp = std::min(st.minSpp, int(c));
+    st.maxSpp = std::max(st.maxSpp, int(c));
+  }
+  st.seconds = seconds;
+  st.peakResidentBytes = peakResidentBytes();
+  return film;
+}
+
+// One level: the checks and the state (startProgressive), the pass loop
+// (local or in rounds over the ranks), the film from the sums.
+Film renderProgressive(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
+                       const Progress& progress, RenderStats& st, dist::Comm& comm) {
+  Timer timer;
+  const ProgressiveStart start = startProgressive(scene, opt, state, progress, st, comm);
   if (!comm.distributed()) {
-    runLocalPasses(scene, opt, state, progress, st, counts, limit, timer);
+    runLocalPasses(scene, opt, state, progress, st, start.counts, start.limit, timer);
   } else {
-    const bool roundDropped = runDistributedRounds(scene, opt, state, progress, st, counts, limit, timer, comm);
+    const bool roundDropped =
+        runDistributedRounds(scene, opt, state, progress, st, start.counts, start.limit, timer, comm);
     if (roundDropped && state.passesDone == 0)  // every rank knows: an agreed error, rank 0 says it
       throw dist::AgreedError("stopped by a signal before the first round of passes ended: nothing to write");
     if (!comm.root()) {
@@ -737,18 +761,7 @@ Film renderProgressive(const Scene& scene, const RenderOptions& opt, Progressive
       return Film();
     }
   }
-  Film film = filmFromState(state, w, h);
-  st.cameraSamples = 0;
-  st.minSpp = n ? int(film.sampleCount[0]) : 0;
-  st.maxSpp = st.minSpp;
-  for (float c : film.sampleCount) {
-    st.cameraSamples += uint64_t(c);
-    st.minSpp = std::min(st.minSpp, int(c));
-    st.maxSpp = std::max(st.maxSpp, int(c));
-  }
-  st.seconds = timer.seconds();
-  st.peakResidentBytes = peakResidentBytes();
-  return film;
+  return finishProgressive(scene, state, st, timer.seconds());
 }
 
 }  // namespace tdpm

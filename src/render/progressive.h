@@ -22,6 +22,7 @@
 // bit-identical images; combining states is summation of their layers.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,7 @@
 #include "distributed/comm.h"
 #include "estimate/fixed_kernel.h"
 #include "render/film.h"
+#include "render/photon_map.h"
 #include "render/progressive_state.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
@@ -60,11 +62,32 @@ PassKernels kernelsForPass(const ProgressiveState& state, const RenderOptions& o
 // inverse of the pass index, rotated by a hash of the seed.
 float accumulationPassTime(int pass, uint64_t seed);
 
+// Where a pass's photon maps come from when not traced from the options
+// (the pass's path range): progressive animation frames that share the
+// time-invariant photons of a block assemble them
+// (render/animation_progressive.cpp). Called with the pass index.
+using PassMapSource = std::function<PhotonMaps(int pass, const Progress& progress)>;
+
 // Runs one pass (index state.passesDone) and adds it into `state`; pixel p
 // takes counts[p] eye samples (render/sample_allocation.h), or opt.spp when
-// `counts` is empty.
+// `counts` is empty; its maps from `source` when it is set.
 void runProgressivePass(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
-                        const Progress& progress, RenderStats& stats, const std::vector<uint32_t>& counts = {});
+                        const Progress& progress, RenderStats& stats, const std::vector<uint32_t>& counts = {},
+                        const PassMapSource& source = {});
+
+// renderProgressive's parts, for a caller that runs the passes itself
+// (progressive animation frames, render/animation_progressive.cpp): the
+// checks, the memory budget of one pass, the state prepared (a new one's
+// layers and settings, a resumed one checked), and the per-pixel sample
+// counts and the time limit (opt.timeLimitSeconds, or the default when
+// neither it nor opt.passes is set); then the film and figures of a state.
+struct ProgressiveStart {
+  std::vector<uint32_t> counts;
+  double limit = 0;
+};
+ProgressiveStart startProgressive(const Scene& scene, const RenderOptions& opt, ProgressiveState& state,
+                                  const Progress& progress, RenderStats& stats, dist::Comm& comm = dist::local());
+Film finishProgressive(const Scene& scene, const ProgressiveState& state, RenderStats& stats, double seconds);
 
 // The pass loop: continues `state` (empty: from pass 0) until opt.passes
 // passes are done in all, or this run has taken opt.timeLimitSeconds (after

@@ -117,6 +117,11 @@ struct RenderOptions {
   // timeline). NaN: the scene's shutter.
   float frameOpen = std::numeric_limits<float>::quiet_NaN();
   float frameClose = std::numeric_limits<float>::quiet_NaN();
+  // Such a frame's passes sharing the time-invariant photons of its block
+  // (docs/animation.md section 6, "Sharing"): what its passes' photons
+  // depend on beyond the frame (block, --shared-photons, ...), as text for
+  // the fingerprint; empty: the frame's own photons alone.
+  std::string frameSharing;
   // Eye samples where the eye paths are noisy (render/sample_allocation.h):
   // every pass gives pixel p m_p in [spp, passSampleCap x spp] samples from
   // an eye-only pilot, with at most passExtraSamples x spp x pixels above
