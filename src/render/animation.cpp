@@ -57,7 +57,11 @@ bool inside(int64_t lo, int64_t hi, int64_t a, int64_t b) { return lo >= a && hi
 // section 7): traced once over the block's time [lo, hi) (bins, clipped to
 // the timeline), energies Q = Phi (hi - lo) w / n over it, times uniform
 // over it (the store's 256 bins span it). A frame spreads them over its own
-// map's time with energies scaled to that length (frameMap).
+// map's time with energies scaled to that length (frameMap). Each kind's
+// store is sorted once into a 3D kd-tree's heap (its split axes set): the
+// frames copy it in that order as the first part of their two-part trees
+// (KdTree::buildAppended), so only their own few photons are sorted per
+// frame.
 struct SharedSet {
   int block = -1;
   int64_t lo = 0, hi = 0;
@@ -95,16 +99,19 @@ void addShared(const SharedSet& sh, MapKind kind, const TimeGrid& g, int64_t lo,
   for (size_t p = 0; p < st.size(); ++p) {
     const int64_t q = st.timeBin(p);
     all.addEncoded(st.xs()[p], st.ys()[p], st.zs()[p], scaledEnergy(st.energies()[p], toMap), st.directions()[p],
-                   st.flags()[p], uint8_t(c0 - lo + q * (c1 - c0) / photon::kTimeBins));
+                   st.flags()[p], uint8_t(c0 - lo + q * (c1 - c0) / photon::kTimeBins), true);
     own.addEncoded(st.xs()[p], st.ys()[p], st.zs()[p], scaledEnergy(st.energies()[p], toShutter), st.directions()[p],
-                   st.flags()[p], uint8_t(q));
+                   st.flags()[p], uint8_t(q), true);
   }
 }
 
 // Frame i's map of one kind: every photon of the segments inside its time
 // map, re-binned on the frame's 256 bins (an integer shift: same grid), and
 // a 3D tree of its shutter's photons alone for the standard estimate.
-// With a shared set, its time-invariant photons join both (addShared).
+// With a shared set, its time-invariant photons join both (addShared), first
+// and in the order of their block's tree, and each tree is that heap plus
+// one over the frame's own photons (a 4D tree is built whole: its order
+// depends on the times, which differ between the two stores).
 std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments, const SharedSet* shared,
                                     MapKind kind, const TimeGrid& g, int frame, int64_t timelineEnd, bool spaceTime,
                                     float kappa) {
@@ -143,9 +150,10 @@ std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments,
   photon::KdBuildOptions opt;
   opt.spaceTime = spaceTime;
   opt.kappa = kappa;
-  map->tree = photon::KdTree::build(map->store, opt);
+  map->tree = shared && !spaceTime ? photon::KdTree::buildAppended(map->store, nShared, opt)
+                                   : photon::KdTree::build(map->store, opt);
   map->store3 = std::move(own);
-  map->tree3 = photon::KdTree::build(map->store3, {});
+  map->tree3 = shared ? photon::KdTree::buildAppended(map->store3, nShared, {}) : photon::KdTree::build(map->store3, {});
   map->separateStandard = true;
   return map;
 }
@@ -362,6 +370,7 @@ class SegmentTimeline {
       countTrace(kind, r);
       stats_.sharedPhotons += r.store.size();
       shared_.stores[kind] = std::move(r.store);
+      photon::KdTree::build(shared_.stores[kind], {});  // into heap order, once per block (SharedSet)
       shared_.kept[kind] = std::move(r.kept);
     }
     stats_.peakKeptStates = std::max(stats_.peakKeptStates, shared_.keptStates());
