@@ -105,6 +105,16 @@ void addShared(const SharedSet& sh, MapKind kind, const TimeGrid& g, int64_t lo,
   }
 }
 
+// Whether a frame's store of `shared` block photons (first, in their
+// block's heap order) and `own` photons of its segments gets a two-part
+// tree (KdTree::buildAppended) rather than one sorted whole. Two parts save
+// sorting the shared photons again but every query near the frame's own
+// photons walks a second heap: measured (bench/README.md, issue 26 fourth
+// pass), a win where the own photons are 0.5% (still-room), a loss of a
+// few percent where they are 2-4 times the shared ones (the rolling ball,
+// the truck). The bound between is a guess, not a measured break-even.
+bool twoPartTree(size_t shared, size_t own) { return shared > 0 && own * 8 <= shared; }
+
 // Frame i's map of one kind: every photon of the segments inside its time
 // map, re-binned on the frame's 256 bins (an integer shift: same grid), and
 // a 3D tree of its shutter's photons alone for the standard estimate.
@@ -150,10 +160,11 @@ std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments,
   photon::KdBuildOptions opt;
   opt.spaceTime = spaceTime;
   opt.kappa = kappa;
-  map->tree = shared && !spaceTime ? photon::KdTree::buildAppended(map->store, nShared, opt)
-                                   : photon::KdTree::build(map->store, opt);
+  map->tree = twoPartTree(nShared, nAll) && !spaceTime ? photon::KdTree::buildAppended(map->store, nShared, opt)
+                                                       : photon::KdTree::build(map->store, opt);
   map->store3 = std::move(own);
-  map->tree3 = shared ? photon::KdTree::buildAppended(map->store3, nShared, {}) : photon::KdTree::build(map->store3, {});
+  map->tree3 = twoPartTree(nShared, nOwn) ? photon::KdTree::buildAppended(map->store3, nShared, {})
+                                          : photon::KdTree::build(map->store3, {});
   map->separateStandard = true;
   return map;
 }
