@@ -96,6 +96,8 @@ struct HomogeneousTransmittance {
   float s0 = 0.0f;
   Rgb operator()(float s) const {
     float l = s - s0;
+    // Grey media (the usual fog): one exp, the same bits as three.
+    if (sigmaT.r == sigmaT.g && sigmaT.g == sigmaT.b) return Rgb(std::exp(-sigmaT.r * l));
     return {std::exp(-sigmaT.r * l), std::exp(-sigmaT.g * l), std::exp(-sigmaT.b * l)};
   }
 };
