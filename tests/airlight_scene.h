@@ -30,6 +30,16 @@ inline double airlight(double I, double sigmaS, double sigmaT, double x0, double
   return sigmaS * I * std::exp(-sigmaT * x0) / (2 * M_PI * h) * sum * (xi1 - xi0) / n;
 }
 
+// An isotropic point light of intensity I at `p`, inside medium `medium`.
+inline scene::LightDesc pointLightIn(int medium, Vec3f p, float I) {
+  scene::LightDesc l;
+  l.type = scene::LightDesc::Type::Point;
+  l.position = p;
+  l.power = Rgb(4 * kPi * I);
+  l.medium = medium;
+  return l;
+}
+
 // Camera at the origin looking along +z, a black wall at z = D facing it,
 // a point light at (h, 0, x0), fog everywhere.
 inline scene::SceneDescription airlightScene(float I, float sa, float ss, float x0, float h, float D) {
@@ -41,12 +51,7 @@ inline scene::SceneDescription airlightScene(float I, float sa, float ss, float 
   d.objects.push_back(test::box({100, 100, 0.01f}, {0, 0, D + 0.005f}, 0));
   d.media.push_back(fog(Rgb(sa), Rgb(ss)));
   d.exteriorMedium = d.camera.medium = 0;
-  scene::LightDesc l;
-  l.type = scene::LightDesc::Type::Point;
-  l.position = {h, 0, x0};
-  l.power = Rgb(4 * kPi * I);
-  l.medium = 0;
-  d.lights.push_back(l);
+  d.lights.push_back(pointLightIn(0, {h, 0, x0}, I));
   return d;
 }
 

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "airlight_scene.h"
 #include "cli_harness.h"
 #include "error_capture.h"
 #include "media/medium.h"
@@ -367,20 +368,8 @@ TEST_CASE("media: Henyey-Greenstein integrates to 1 and its sampler follows it")
 
 namespace {
 
-// Sun et al. 2005's airlight integral: single scattering of an isotropic
-// point light of intensity I at distance h from a ray, closest at ray
-// parameter x0, along [0, D], in a medium (sigma_s, sigma_t), isotropic phase.
-double airlight(double I, double sigmaS, double sigmaT, double x0, double h, double D) {
-  double xi0 = M_PI / 4 + std::atan(-x0 / h) / 2, xi1 = M_PI / 4 + std::atan((D - x0) / h) / 2;
-  const int n = 20000;
-  double sum = 0;
-  for (int i = 0; i < n; ++i) {
-    double xi = xi0 + (xi1 - xi0) * (i + 0.5) / n;
-    sum += std::exp(-sigmaT * h * std::tan(xi));
-  }
-  sum *= (xi1 - xi0) / n;
-  return sigmaS * I * std::exp(-sigmaT * x0) / (2 * M_PI * h) * sum;
-}
+// Sun et al.'s airlight integral: test::airlight (tests/airlight_scene.h).
+using test::airlight;
 
 // The same by direct quadrature along the ray (checks the formula's use).
 double airlightDirect(double I, double sigmaS, double sigmaT, double x0, double h, double D) {
@@ -406,12 +395,7 @@ scene::SceneDescription airlightScene(float I, float sigmaA, float sigmaS, float
   d.media.push_back(homogeneousDesc(Rgb(sigmaA), Rgb(sigmaS)));
   d.media[0].name = "fog";
   d.exteriorMedium = d.camera.medium = 0;
-  scene::LightDesc l;
-  l.type = scene::LightDesc::Type::Point;
-  l.position = {h, 0, x0};
-  l.power = Rgb(4 * kPi * I);
-  l.medium = 0;
-  d.lights.push_back(l);
+  d.lights.push_back(test::pointLightIn(0, {h, 0, x0}, I));
   return d;
 }
 
