@@ -222,15 +222,13 @@ void buildDistributed(const Builder<D>& b, Item<D>* items, size_t n, dist::Comm&
   }
 }
 
-// The heap of photons [first, n) of `store`: order[node] = the photon index
-// (of the whole store) at heap node `node` of that part, axes its split axis.
 template <int D>
-void buildTree(const PhotonStore& store, size_t first, const float* timeKey, size_t cutoff, dist::Comm* comm,
+void buildTree(const PhotonStore& store, const float* timeKey, size_t cutoff, dist::Comm* comm,
                std::vector<uint32_t>& order, std::vector<uint8_t>& axes) {
-  size_t n = store.size() - first;
+  size_t n = store.size();
   std::vector<Item<D>> items(n);
-  const float *X = store.xs() + first, *Y = store.ys() + first, *Z = store.zs() + first;
-  const uint16_t* F = store.flags() + first;
+  const float *X = store.xs(), *Y = store.ys(), *Z = store.zs();
+  const uint16_t* F = store.flags();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i != r.end(); ++i) {
       Item<D>& t = items[i];
@@ -238,7 +236,7 @@ void buildTree(const PhotonStore& store, size_t first, const float* timeKey, siz
       t.k[1] = Y[i];
       t.k[2] = Z[i];
       if constexpr (D == 4) t.k[3] = timeKey[F[i] & kTimeMask];
-      t.idx = uint32_t(first + i);
+      t.idx = uint32_t(i);
     }
   });
   order.resize(n);
@@ -252,73 +250,31 @@ void buildTree(const PhotonStore& store, size_t first, const float* timeKey, siz
 
 }  // namespace
 
-// The tree's fields for `store` and the 4D time key of every bin.
-KdTree KdTree::prepare(PhotonStore& store, const KdBuildOptions& options, float* timeKey) {
+KdTree KdTree::build(PhotonStore& store, const KdBuildOptions& options) {
   TDPM_ASSERT(store.size() < (size_t(1) << 32), "kd-tree indices are 32-bit");
   TDPM_ASSERT(!options.spaceTime || options.kappa > 0.0f, "4D kd-tree needs kappa > 0");
   KdTree tree;
   tree.store_ = &store;
   tree.n_ = store.size();
-  tree.first_ = store.size();
   tree.spaceTime_ = options.spaceTime;
   tree.kappa_ = options.kappa;
   float sk = std::sqrt(options.kappa);
   tree.timeBase_ = sk * store.time().binCentre(0);
   tree.timeStep_ = sk * store.time().binWidth;
-  for (int q = 0; q < kTimeBins; ++q) timeKey[q] = tree.timeBase_ + float(q) * tree.timeStep_;
-  return tree;
-}
-
-KdTree KdTree::build(PhotonStore& store, const KdBuildOptions& options) {
   float timeKey[kTimeBins];
-  KdTree tree = prepare(store, options, timeKey);
+  for (int q = 0; q < kTimeBins; ++q) timeKey[q] = tree.timeBase_ + float(q) * tree.timeStep_;
+
   std::vector<uint32_t> localOrder;
   std::vector<uint32_t>& order = options.order ? *options.order : localOrder;
   std::vector<uint8_t> axes;
   if (options.spaceTime)
-    buildTree<4>(store, 0, timeKey, options.parallelCutoff, options.comm, order, axes);
+    buildTree<4>(store, timeKey, options.parallelCutoff, options.comm, order, axes);
   else
-    buildTree<3>(store, 0, timeKey, options.parallelCutoff, options.comm, order, axes);
+    buildTree<3>(store, timeKey, options.parallelCutoff, options.comm, order, axes);
   store.permute(order.data());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, tree.n_, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i != r.end(); ++i) store.setSplitAxis(i, axes[i]);
   });
-  return tree;
-}
-
-KdTree KdTree::buildAppended(PhotonStore& store, size_t built, const KdBuildOptions& options) {
-  TDPM_ASSERT(built <= store.size(), "kd-tree: the built part exceeds the store");
-  float timeKey[kTimeBins];
-  KdTree tree = prepare(store, options, timeKey);
-  tree.first_ = built;
-  std::vector<uint32_t> part;
-  std::vector<uint8_t> axes;
-  if (options.spaceTime)
-    buildTree<4>(store, built, timeKey, options.parallelCutoff, nullptr, part, axes);
-  else
-    buildTree<3>(store, built, timeKey, options.parallelCutoff, nullptr, part, axes);
-  std::vector<uint32_t> localOrder;
-  std::vector<uint32_t>& order = options.order ? *options.order : localOrder;
-  order.resize(store.size());
-  for (size_t i = 0; i < built; ++i) order[i] = uint32_t(i);
-  std::copy(part.begin(), part.end(), order.begin() + std::ptrdiff_t(built));
-  store.permute(order.data());
-  for (size_t j = 0; j < axes.size(); ++j) store.setSplitAxis(built + j, axes[j]);
-  for (int a = 0; a < 4; ++a) {
-    tree.secondLo_[a] = std::numeric_limits<float>::infinity();
-    tree.secondHi_[a] = -std::numeric_limits<float>::infinity();
-  }
-  for (size_t i = built; i < store.size(); ++i) {
-    const float k[4] = {store.xs()[i], store.ys()[i], store.zs()[i], timeKey[store.timeBin(i)]};
-    for (int a = 0; a < 4; ++a) {
-      tree.secondLo_[a] = std::min(tree.secondLo_[a], k[a]);
-      tree.secondHi_[a] = std::max(tree.secondHi_[a], k[a]);
-    }
-  }
-  // The search computes a time key its own way (rounded otherwise, perhaps
-  // fused): a bin's width of slack keeps the skip test conservative.
-  tree.secondLo_[3] -= std::fabs(tree.timeStep_);
-  tree.secondHi_[3] += std::fabs(tree.timeStep_);
   return tree;
 }
 
@@ -336,111 +292,96 @@ int KdTree::knnImpl(const float* key, int k, float maxRadius2, KnnQuery& q) cons
   q.maxFound2 = 0.0f;
   if (n_ == 0 || k <= 0 || !(maxRadius2 > 0.0f)) return 0;
   q.reserve(k);
-  uint32_t* idxAll = q.index_.data();
-  float* d2All = q.dist2_.data();
-  KnnQuery::StackEntry* stackAll = q.stack_.data();
+  const float *X = store_->xs(), *Y = store_->ys(), *Z = store_->zs();
+  const uint16_t* F = store_->flags();
+  uint32_t* idx = q.index_.data();
+  float* d2 = q.dist2_.data();
+  KnnQuery::StackEntry* stack = q.stack_.data();
+  const uint32_t n = uint32_t(n_);
+  const float kx = key[0], ky = key[1], kz = key[2];
+  const float kt = D == 4 ? key[3] : 0.0f;
+
   float r2 = maxRadius2;
-  int count = 0;
+  int count = 0, sp = 0;
+  // Offsets of the query from the current cell per axis (0 inside its slab);
+  // cellDist2 = sum of their squares bounds every photon of the subtree.
+  float off[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  float cellDist2 = 0.0f;
 
-  // One heap part: photons [base, base + n), node j at base + j. The
-  // candidate heap (count, r2) carries over from part to part; inside a
-  // part it is held in locals (the walk is not inlined: captured by
-  // reference, every offer would go through memory).
-  auto walk = [&, key](uint32_t base, uint32_t n) {
-    const float *X = store_->xs() + base, *Y = store_->ys() + base, *Z = store_->zs() + base;
-    const uint16_t* F = store_->flags() + base;
-    float r2Part = r2;
-    int countPart = count;
-    uint32_t* idx = idxAll;
-    float* d2 = d2All;
-    KnnQuery::StackEntry* stack = stackAll;
-    const float kx = key[0], ky = key[1], kz = key[2];
-    const float kt = D == 4 ? key[3] : 0.0f;
-    int sp = 0;
-    // Offsets of the query from the current cell per axis (0 inside its slab);
-    // cellDist2 = sum of their squares bounds every photon of the subtree.
-    float off[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-    float cellDist2 = 0.0f;
-
-    auto test = [&](uint32_t p) {
-      float dx = X[p] - kx, dy = Y[p] - ky, dz = Z[p] - kz;
-      float dist = dx * dx + dy * dy + dz * dz;
-      if constexpr (D == 4) {
-        float dt = timeBase_ + float(F[p] & kTimeMask) * timeStep_ - kt;
-        dist += dt * dt;
-      }
-      if (dist < r2Part) knnOffer(d2, idx, k, countPart, r2Part, base + p, dist);
-    };
-
-    uint32_t node = 0;
-    for (;;) {
-      // ---- descend to a leaf along the query's side, deferring each node
-      //      (tested later, like Jensen's recursion) and its far side ----
-      for (;;) {
-        uint32_t left = 2 * node + 1;
-        if (left >= n) {
-          test(node);
-          break;
-        }
-        // The subtree four levels down is 16 consecutive nodes: fetch them
-        // early, the descent is otherwise a chain of dependent cache misses.
-        uint32_t ahead = 16 * node + 15;
-        if (ahead < n) {
-          __builtin_prefetch(X + ahead);
-          __builtin_prefetch(Y + ahead);
-          __builtin_prefetch(Z + ahead);
-          __builtin_prefetch(F + ahead);
-        }
-        int axis = (F[node] & kAxisMask) >> kAxisShift;
-        float split;
-        if constexpr (D == 4)
-          split = axis == 0 ? X[node] : axis == 1 ? Y[node] : axis == 2 ? Z[node]
-                                                            : timeBase_ + float(F[node] & kTimeMask) * timeStep_;
-        else
-          split = axis == 0 ? X[node] : axis == 1 ? Y[node] : Z[node];
-        // delta > 0: the query is on the left (<= split) side.
-        float delta = split - key[axis];
-        uint32_t nearC = delta > 0.0f ? left : left + 1;
-        uint32_t farC = delta > 0.0f ? left + 1 : left;
-        // The far cell (and the node, on the plane) lie beyond the plane: the
-        // offset on this axis becomes |delta|, never less than the current one.
-        float farDist2 = cellDist2 - off[axis] * off[axis] + delta * delta;
-        if (farDist2 < r2Part) {
-          KnnQuery::StackEntry& e = stack[sp++];
-          e.node = node;
-          e.far = farC < n ? farC : 0;
-          e.cellDist2 = farDist2;
-          for (int a = 0; a < D; ++a) e.offset[a] = off[a];
-          e.offset[axis] = delta;
-        }
-        if (nearC >= n) break;
-        node = nearC;
-      }
-      // ---- pop the next deferred node still within the current radius ----
-      bool found = false;
-      while (sp > 0) {
-        const KnnQuery::StackEntry& e = stack[--sp];
-        if (e.cellDist2 < r2Part) {
-          test(e.node);
-          if (e.far == 0 || !(e.cellDist2 < r2Part)) continue;
-          node = e.far;
-          cellDist2 = e.cellDist2;
-          for (int a = 0; a < D; ++a) off[a] = e.offset[a];
-          found = true;
-          break;
-        }
-      }
-      if (!found) break;
+  auto test = [&](uint32_t p) {
+    float dx = X[p] - kx, dy = Y[p] - ky, dz = Z[p] - kz;
+    float dist = dx * dx + dy * dy + dz * dz;
+    if constexpr (D == 4) {
+      float dt = timeBase_ + float(F[p] & kTimeMask) * timeStep_ - kt;
+      dist += dt * dt;
     }
-    r2 = r2Part;
-    count = countPart;
+    if (dist < r2) knnOffer(d2, idx, k, count, r2, p, dist);
   };
-  if (first_ > 0) walk(0, uint32_t(first_));
-  if (n_ > first_ && secondBoxDist2(key, D) < r2) walk(uint32_t(first_), uint32_t(n_ - first_));
+
+  uint32_t node = 0;
+  for (;;) {
+    // ---- descend to a leaf along the query's side, deferring each node
+    //      (tested later, like Jensen's recursion) and its far side ----
+    for (;;) {
+      uint32_t left = 2 * node + 1;
+      if (left >= n) {
+        test(node);
+        break;
+      }
+      // The subtree four levels down is 16 consecutive nodes: fetch them
+      // early, the descent is otherwise a chain of dependent cache misses.
+      uint32_t ahead = 16 * node + 15;
+      if (ahead < n) {
+        __builtin_prefetch(X + ahead);
+        __builtin_prefetch(Y + ahead);
+        __builtin_prefetch(Z + ahead);
+        __builtin_prefetch(F + ahead);
+      }
+      int axis = (F[node] & kAxisMask) >> kAxisShift;
+      float split;
+      if constexpr (D == 4)
+        split = axis == 0 ? X[node] : axis == 1 ? Y[node] : axis == 2 ? Z[node]
+                                                          : timeBase_ + float(F[node] & kTimeMask) * timeStep_;
+      else
+        split = axis == 0 ? X[node] : axis == 1 ? Y[node] : Z[node];
+      // delta > 0: the query is on the left (<= split) side.
+      float delta = split - key[axis];
+      uint32_t nearC = delta > 0.0f ? left : left + 1;
+      uint32_t farC = delta > 0.0f ? left + 1 : left;
+      // The far cell (and the node, on the plane) lie beyond the plane: the
+      // offset on this axis becomes |delta|, never less than the current one.
+      float farDist2 = cellDist2 - off[axis] * off[axis] + delta * delta;
+      if (farDist2 < r2) {
+        KnnQuery::StackEntry& e = stack[sp++];
+        e.node = node;
+        e.far = farC < n ? farC : 0;
+        e.cellDist2 = farDist2;
+        for (int a = 0; a < D; ++a) e.offset[a] = off[a];
+        e.offset[axis] = delta;
+      }
+      if (nearC >= n) break;
+      node = nearC;
+    }
+    // ---- pop the next deferred node still within the current radius ----
+    bool found = false;
+    while (sp > 0) {
+      const KnnQuery::StackEntry& e = stack[--sp];
+      if (e.cellDist2 < r2) {
+        test(e.node);
+        if (e.far == 0 || !(e.cellDist2 < r2)) continue;
+        node = e.far;
+        cellDist2 = e.cellDist2;
+        for (int a = 0; a < D; ++a) off[a] = e.offset[a];
+        found = true;
+        break;
+      }
+    }
+    if (!found) break;
+  }
 
   q.count = count;
   float mx = 0.0f;
-  for (int i = 0; i < count; ++i) mx = std::max(mx, d2All[i]);
+  for (int i = 0; i < count; ++i) mx = std::max(mx, d2[i]);
   q.maxFound2 = mx;
   q.radius2 = count == k ? r2 : maxRadius2;
   return count;
@@ -457,51 +398,46 @@ int KdTree::range(Vec3f p, float radius2, RangeQuery& q) const {
   q.count = 0;
   if (n_ == 0 || !(radius2 > 0.0f)) return 0;
   if (q.index_.empty()) q.grow();
+  const float *X = store_->xs(), *Y = store_->ys(), *Z = store_->zs();
+  const uint16_t* F = store_->flags();
+  const uint32_t n = uint32_t(n_);
   const float key[3] = {p.x, p.y, p.z};
-  int count = 0;
-  // One heap part: photons [base, base + n), node j at base + j.
-  auto walk = [&](uint32_t base, uint32_t n) {
-    const float *X = store_->xs() + base, *Y = store_->ys() + base, *Z = store_->zs() + base;
-    const uint16_t* F = store_->flags() + base;
-    uint32_t stack[128];  // far children waiting: at most one per level
-    int sp = 0;
-    uint32_t cap = uint32_t(q.index_.size());
-    uint32_t* idx = q.index_.data();
-    float* d2 = q.dist2_.data();
-    uint32_t node = 0;
+  uint32_t stack[128];  // far children waiting: at most one per level
+  int sp = 0, count = 0;
+  uint32_t cap = uint32_t(q.index_.size());
+  uint32_t* idx = q.index_.data();
+  float* d2 = q.dist2_.data();
+  uint32_t node = 0;
+  for (;;) {
     for (;;) {
-      for (;;) {
-        float dx = X[node] - key[0], dy = Y[node] - key[1], dz = Z[node] - key[2];
-        float dist = dx * dx + dy * dy + dz * dz;
-        if (dist <= radius2) {
-          if (uint32_t(count) == cap) {
-            q.grow();
-            cap = uint32_t(q.index_.size());
-            idx = q.index_.data();
-            d2 = q.dist2_.data();
-          }
-          idx[count] = base + node;
-          d2[count] = dist;
-          ++count;
+      float dx = X[node] - key[0], dy = Y[node] - key[1], dz = Z[node] - key[2];
+      float dist = dx * dx + dy * dy + dz * dz;
+      if (dist <= radius2) {
+        if (uint32_t(count) == cap) {
+          q.grow();
+          cap = uint32_t(q.index_.size());
+          idx = q.index_.data();
+          d2 = q.dist2_.data();
         }
-        uint32_t left = 2 * node + 1;
-        if (left >= n) break;
-        int axis = (F[node] & kAxisMask) >> kAxisShift;
-        float delta = key[axis] - (axis == 0 ? X[node] : axis == 1 ? Y[node] : Z[node]);
-        // Left holds keys <= split, right >= split: the far side is at least
-        // |delta| away on this axis.
-        uint32_t nearC = delta < 0.0f ? left : left + 1;
-        uint32_t farC = delta < 0.0f ? left + 1 : left;
-        if (delta * delta <= radius2 && farC < n) stack[sp++] = farC;
-        if (nearC >= n) break;
-        node = nearC;
+        idx[count] = node;
+        d2[count] = dist;
+        ++count;
       }
-      if (sp == 0) break;
-      node = stack[--sp];
+      uint32_t left = 2 * node + 1;
+      if (left >= n) break;
+      int axis = (F[node] & kAxisMask) >> kAxisShift;
+      float delta = key[axis] - (axis == 0 ? X[node] : axis == 1 ? Y[node] : Z[node]);
+      // Left holds keys <= split, right >= split: the far side is at least
+      // |delta| away on this axis.
+      uint32_t nearC = delta < 0.0f ? left : left + 1;
+      uint32_t farC = delta < 0.0f ? left + 1 : left;
+      if (delta * delta <= radius2 && farC < n) stack[sp++] = farC;
+      if (nearC >= n) break;
+      node = nearC;
     }
-  };
-  if (first_ > 0) walk(0, uint32_t(first_));
-  if (n_ > first_ && secondBoxDist2(key, 3) <= radius2) walk(uint32_t(first_), uint32_t(n_ - first_));
+    if (sp == 0) break;
+    node = stack[--sp];
+  }
   q.count = count;
   return count;
 }

@@ -4,13 +4,6 @@
 // reorders the store in place and writes only the split axis into the
 // photons' flag bits, so the tree costs no memory beyond the store.
 //
-// A tree may have two parts in one store (buildAppended): a heap over
-// photons [0, m) built earlier, and a second heap over [m, n) (node j at
-// m + j, children m + 2j + 1, m + 2j + 2). Every query walks both with one
-// candidate heap, so its result is that of one search over the union
-// (animations: a block's shared photons, sorted once, and a frame's few
-// own photons, render/animation.cpp).
-//
 // Two variants share the layout and the code:
 //  * 3D: keys x, y, z; k-nearest-neighbour search in space.
 //  * 4D (space-time): a fourth key sqrt(kappa) * t_p (bin centre), so that
@@ -21,7 +14,6 @@
 // Queries write into a KnnQuery, a per-thread object with fixed-capacity
 // arrays (max-heap of candidates, traversal stack): no allocation per query.
 #pragma once
-#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <utility>
@@ -126,14 +118,6 @@ class KdTree {
   // Reorders `store` into heap order and records split axes; `store` must
   // outlive the tree and not change until the next build. Parallel (TBB).
   static KdTree build(PhotonStore& store, const KdBuildOptions& options = {});
-  // `store`'s photons [0, built) are already a tree's heap (ordered and
-  // their split axes set by build() with the same options, e.g. copied with
-  // their flags from a store that was built); builds the heap of [built, n)
-  // after them and returns the two-part tree over all n (see the top).
-  // Serial and local: for small second parts (options.comm is not used).
-  static KdTree buildAppended(PhotonStore& store, size_t built, const KdBuildOptions& options = {});
-  // Photons in the first heap (== size() for a one-part tree).
-  size_t firstPart() const { return first_; }
 
   const PhotonStore& store() const { return *store_; }
   size_t size() const { return n_; }
@@ -158,23 +142,8 @@ class KdTree {
   template <int D>
   int knnImpl(const float* key, int k, float maxRadius2, KnnQuery& q) const;
 
-  static KdTree prepare(PhotonStore& store, const KdBuildOptions& options, float* timeKey);
-
   const PhotonStore* store_ = nullptr;
   size_t n_ = 0;
-  size_t first_ = 0;  // photons [0, first_) are the first heap, [first_, n_) the second
-  // The second heap's bounds in the search keys (x, y, z, and the 4D time
-  // key): a query whose ball misses them skips that heap (a frame's own
-  // photons lie near what moves, most queries are far from it).
-  float secondLo_[4] = {0, 0, 0, 0}, secondHi_[4] = {0, 0, 0, 0};
-  float secondBoxDist2(const float* key, int dims) const {
-    float d2 = 0.0f;
-    for (int a = 0; a < dims; ++a) {
-      float d = std::max(std::max(secondLo_[a] - key[a], key[a] - secondHi_[a]), 0.0f);
-      d2 += d * d;
-    }
-    return d2;
-  }
   bool spaceTime_ = false;
   float kappa_ = 1.0f;
   // 4D time key of bin q: sqrt(kappa) * binCentre(q) = timeBase_ + q * timeStep_.

@@ -127,17 +127,14 @@ class PhotonStore {
   }
   // A photon copied from another store as it is encoded there, with time bin
   // `bin` of this store's range (animations: segments of one time grid
-  // merged into a frame's map, render/animation.cpp). The axis bits clear,
-  // or are kept with keepSplitAxis (a copy of a built kd-tree's heap in its
-  // order, KdTree::buildAppended).
-  void addEncoded(float x, float y, float z, uint32_t energy, uint16_t direction, uint16_t flags, uint8_t bin,
-                  bool keepSplitAxis = false) {
+  // merged into a frame's map, render/animation.cpp). The axis bits clear.
+  void addEncoded(float x, float y, float z, uint32_t energy, uint16_t direction, uint16_t flags, uint8_t bin) {
     x_.push_back(x);
     y_.push_back(y);
     z_.push_back(z);
     energy_.push_back(energy);
     direction_.push_back(direction);
-    flags_.push_back(uint16_t((flags & (keepSplitAxis ? uint16_t(kUserMask | kAxisMask) : kUserMask)) | bin));
+    flags_.push_back(uint16_t((flags & kUserMask) | bin));
   }
   // Concatenate batches (each filled by one thread, same time range) after
   // the photons already here, in the order of `batches`; copies in parallel.

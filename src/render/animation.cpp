@@ -57,11 +57,7 @@ bool inside(int64_t lo, int64_t hi, int64_t a, int64_t b) { return lo >= a && hi
 // section 7): traced once over the block's time [lo, hi) (bins, clipped to
 // the timeline), energies Q = Phi (hi - lo) w / n over it, times uniform
 // over it (the store's 256 bins span it). A frame spreads them over its own
-// map's time with energies scaled to that length (frameMap). Each surface
-// kind's store is sorted once into a 3D kd-tree's heap (its split axes
-// set): the frames copy it in that order as the first part of their
-// two-part trees (KdTree::buildAppended), so only their own few photons are
-// sorted per frame.
+// map's time with energies scaled to that length (frameMap).
 struct SharedSet {
   int block = -1;
   int64_t lo = 0, hi = 0;
@@ -93,9 +89,6 @@ struct FrameStore {
   // The shared set's photons: energy x sharedBins / (block length), its
   // place q of 256 in the block's time at store bin sharedOff + q sharedSpan / 256.
   int64_t sharedBins = 0, sharedOff = 0, sharedSpan = photon::kTimeBins;
-  // Surfaces: the shared photons keep their block's kd-tree heap order and
-  // split axes, the first part of a two-part tree (KdTree::buildAppended).
-  bool sharedHeap = false;
 };
 
 // Photons of one kind of the segments inside grid bins [a, b) and of the
@@ -129,8 +122,7 @@ photon::PhotonStore frameStore(const std::vector<const Segment*>& segments, cons
     const float factor = float(double(f.sharedBins) / double(shared->hi - shared->lo));
     for (size_t p = 0; p < st.size(); ++p)
       out.addEncoded(st.xs()[p], st.ys()[p], st.zs()[p], scaledEnergy(st.energies()[p], factor), st.directions()[p],
-                     st.flags()[p], uint8_t(f.sharedOff + st.timeBin(p) * f.sharedSpan / photon::kTimeBins),
-                     f.sharedHeap);
+                     st.flags()[p], uint8_t(f.sharedOff + st.timeBin(p) * f.sharedSpan / photon::kTimeBins));
   }
   for (const Segment* s : segments) {
     if (!inside(s->lo, s->hi, f.a, f.b)) continue;
@@ -146,16 +138,6 @@ photon::PhotonStore frameStore(const std::vector<const Segment*>& segments, cons
   return out;
 }
 
-// Whether a frame's store of `shared` block photons (first, in their
-// block's heap order) and `own` photons of its segments gets a two-part
-// tree (KdTree::buildAppended) rather than one sorted whole. Two parts save
-// sorting the shared photons again but every query near the frame's own
-// photons walks a second heap: measured (bench/README.md, issue 26 fourth
-// pass), a win where the own photons are 0.5% (still-room), a loss of a
-// few percent where they are 2-4 times the shared ones (the rolling ball,
-// the truck). The bound between is a guess, not a measured break-even.
-bool twoPartTree(size_t shared, size_t own) { return shared > 0 && own * 8 <= shared; }
-
 // Frame i's map of one kind, from the segments inside its time map and the
 // block's shared set (docs/animation.md sections 5 and 7). Surfaces: every
 // photon of the time map, re-binned on the frame's 256 bins (an integer
@@ -168,11 +150,7 @@ bool twoPartTree(size_t shared, size_t own) { return shared > 0 && own * 8 <= sh
 // beam estimate treats the store's ends as the photons' ends: it reflects
 // the windows there and spreads a whole-shutter photon over all 256 bins;
 // and a Standard one over the shutter's photons for the skip rule's
-// standard form (the shutter's average, not the pads'). Surfaces with a
-// shared set: its time-invariant photons first and in the order of their
-// block's tree, each tree that heap plus one over the frame's own photons
-// (twoPartTree; a 4D tree is built whole: its order depends on the times,
-// which differ between the two stores).
+// standard form (the shutter's average, not the pads').
 std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments, const SharedSet* shared,
                                     MapKind kind, const TimeGrid& g, int frame, const FrameMapSettings& fs) {
   const int64_t lo = g.mapLo(frame), hi = g.mapHi(frame);
@@ -197,20 +175,13 @@ std::unique_ptr<PhotonMap> frameMap(const std::vector<const Segment*>& segments,
     return map;
   }
   map->separateStandard = true;
-  const size_t nShared = shared ? shared->stores[kind].size() : 0;
-  map->store = frameStore(segments, shared, kind, g,
-                          FrameStore{lo, hi, lo, photon::kTimeBins, c1 - c0, c0 - lo, c1 - c0, true});
+  map->store = frameStore(segments, shared, kind, g, FrameStore{lo, hi, lo, photon::kTimeBins, c1 - c0, c0 - lo, c1 - c0});
   photon::KdBuildOptions opt;
   opt.spaceTime = fs.spaceTime;
   opt.kappa = fs.kappa;
-  map->tree = twoPartTree(nShared, map->store.size() - nShared) && !fs.spaceTime
-                  ? photon::KdTree::buildAppended(map->store, nShared, opt)
-                  : photon::KdTree::build(map->store, opt);
-  FrameStore ownHeap = own;
-  ownHeap.sharedHeap = true;
-  map->store3 = frameStore(segments, shared, kind, g, ownHeap);
-  map->tree3 = twoPartTree(nShared, map->store3.size() - nShared) ? photon::KdTree::buildAppended(map->store3, nShared, {})
-                                                                   : photon::KdTree::build(map->store3, {});
+  map->tree = photon::KdTree::build(map->store, opt);
+  map->store3 = frameStore(segments, shared, kind, g, own);
+  map->tree3 = photon::KdTree::build(map->store3, {});
   return map;
 }
 
@@ -380,8 +351,6 @@ class SegmentTimeline {
       countTrace(kind, r);
       stats_.sharedPhotons += r.store.size();
       shared_.stores[kind] = std::move(r.store);
-      if (kind != MapKind::Volume)  // into heap order, once per block (SharedSet); beam maps order their own
-        photon::KdTree::build(shared_.stores[kind], {});
       shared_.kept[kind] = std::move(r.kept);
     }
     stats_.peakKeptStates = std::max(stats_.peakKeptStates, shared_.keptStates());
